@@ -1,0 +1,138 @@
+"""Camera, clip sphere and shading shared by every runner, the CPU reference included.
+
+This module is the single definition of a pixel's ray and of its colour. The shader
+templates receive these same constants as printed literals, and the CPU reference uses
+the numpy functions below, so a GPU image and the reference are directly comparable.
+
+Pixel (i, j), column i from the left and row j from the top, is the ray from `eye`
+through the image-plane point at distance 1 along the view direction:
+    ndc_x = 2 (i + 0.5) / W - 1,   ndc_y = 1 - 2 (j + 0.5) / H
+    dir   = normalize(forward + ndc_x * tan(fov_y/2) * (W/H) * right + ndc_y * tan(fov_y/2) * up)
+with forward = normalize(target - eye), right = normalize(forward x up_hint),
+up = right x forward.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class View:
+    """Where the camera is and which part of space holds the surface."""
+
+    eye: Vec3 = (3.0, 2.0, 4.0)
+    target: Vec3 = (0.0, 0.0, 0.0)
+    up: Vec3 = (0.0, 1.0, 0.0)
+    fov_y_deg: float = 30.0
+    clip_center: Vec3 = (0.0, 0.0, 0.0)
+    clip_radius: float = 1.5
+
+    def camera_json(self, width: int, height: int) -> dict:
+        return {
+            "eye": list(self.eye),
+            "target": list(self.target),
+            "up": list(self.up),
+            "fov_y_deg": self.fov_y_deg,
+            "width": width,
+            "height": height,
+        }
+
+    def clip_json(self) -> dict:
+        return {"center": list(self.clip_center), "radius": self.clip_radius}
+
+
+@dataclass(frozen=True)
+class Light:
+    direction: Vec3  # towards the light, world space, normalized when used
+    color: Vec3
+
+
+@dataclass(frozen=True)
+class Shading:
+    """Two-sided Blinn-Phong; the side is chosen by the sign of grad(S) . D."""
+
+    front: Vec3 = (0.90, 0.62, 0.25)
+    back: Vec3 = (0.30, 0.55, 0.90)
+    background: Vec3 = (0.08, 0.08, 0.10)
+    ambient: float = 0.18
+    specular: float = 0.35
+    shininess: float = 48.0
+    lights: tuple[Light, ...] = field(
+        default=(
+            Light((0.45, 0.75, 0.50), (0.85, 0.85, 0.85)),
+            Light((-0.60, -0.20, 0.75), (0.35, 0.35, 0.40)),
+        )
+    )
+
+
+SHADING = Shading()
+
+
+def normalize(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.where(n == 0.0, 1.0, n)
+
+
+def camera_basis(view: View) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(forward, right, up) unit vectors of the camera."""
+    forward = normalize(np.subtract(view.target, view.eye).astype(np.float64))
+    right = normalize(np.cross(forward, np.asarray(view.up, dtype=np.float64)))
+    up = np.cross(right, forward)
+    return forward, right, up
+
+
+def pixel_rays(view: View, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Ray origins and unit directions, arrays of shape (height, width, 3), row 0 on top."""
+    forward, right, up = camera_basis(view)
+    tan_half = math.tan(math.radians(view.fov_y_deg) / 2.0)
+    i = np.arange(width, dtype=np.float64)
+    j = np.arange(height, dtype=np.float64)
+    ndc_x = 2.0 * (i + 0.5) / width - 1.0
+    ndc_y = 1.0 - 2.0 * (j + 0.5) / height
+    sx = (ndc_x * tan_half * width / height)[None, :, None]
+    sy = (ndc_y * tan_half)[:, None, None]
+    dirs = normalize(forward[None, None, :] + sx * right[None, None, :] + sy * up[None, None, :])
+    origins = np.broadcast_to(np.asarray(view.eye, dtype=np.float64), dirs.shape).copy()
+    return origins, dirs
+
+
+def clip_sphere(
+    origins: np.ndarray, dirs: np.ndarray, center: Vec3, radius: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """[t_near, t_far] of each ray inside the sphere, and whether it meets it at all.
+
+    t_near is clamped to 0 when the eye is inside the sphere.
+    """
+    oc = origins - np.asarray(center, dtype=np.float64)
+    b = np.sum(oc * dirs, axis=-1)
+    c = np.sum(oc * oc, axis=-1) - radius * radius
+    disc = b * b - c
+    hit = disc > 0.0
+    root = np.sqrt(np.where(hit, disc, 0.0))
+    t_near = np.maximum(-b - root, 0.0)
+    t_far = -b + root
+    hit &= t_far > t_near
+    return t_near, t_far, hit
+
+
+def shade(grad: np.ndarray, dirs: np.ndarray, hit: np.ndarray, shading: Shading = SHADING):
+    """Colour (H, W, 3) in [0, 1] from the surface gradient at each hit point."""
+    n = normalize(grad)
+    facing = np.sum(n * dirs, axis=-1, keepdims=True)
+    base = np.where(facing < 0.0, np.asarray(shading.front), np.asarray(shading.back))
+    n = np.where(facing < 0.0, n, -n)  # two-sided: the normal faces the viewer
+    color = shading.ambient * base
+    for light in shading.lights:
+        ldir = normalize(np.asarray(light.direction, dtype=np.float64))
+        diffuse = np.maximum(np.sum(n * ldir, axis=-1, keepdims=True), 0.0)
+        half = normalize(ldir - dirs)
+        spec = np.maximum(np.sum(n * half, axis=-1, keepdims=True), 0.0) ** shading.shininess
+        color = color + np.asarray(light.color) * (diffuse * base + shading.specular * spec)
+    color = np.clip(color, 0.0, 1.0)
+    return np.where(hit[..., None], color, np.asarray(shading.background))
