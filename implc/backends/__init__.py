@@ -1,0 +1,32 @@
+"""The target registry. Adding a target = a printer module, templates/<name>/, a validator
+in implc/validate.py and one line here (see README "Adding a target")."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from .glsl import FLAVORS as GLSL_FLAVORS
+from .glsl import GlslPrinter
+
+
+@dataclass(frozen=True)
+class Target:
+    name: str
+    extension: str  # of a program; libraries use the same
+    printer: Callable[[], object]
+    flavors: dict[str, dict] = field(default_factory=lambda: {"default": {}})
+    default_flavor: str = "default"
+    vector_types: tuple[str, str, str] = ("float", "vec2", "vec3")
+
+
+TARGETS: dict[str, Target] = {
+    "glsl": Target("glsl", "frag", GlslPrinter, GLSL_FLAVORS, "330"),
+}
+
+
+def get_target(name: str) -> Target:
+    try:
+        return TARGETS[name]
+    except KeyError:
+        raise ValueError(f"unknown target '{name}'; choose from {', '.join(TARGETS)}") from None

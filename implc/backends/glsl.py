@@ -1,0 +1,23 @@
+"""GLSL target: sympy's GLSL printer with implc's shader rules, and its flavours."""
+
+from __future__ import annotations
+
+from sympy.printing.glsl import GLSLPrinter
+
+from .printing import ShaderPrinterMixin
+
+
+class GlslPrinter(ShaderPrinterMixin, GLSLPrinter):
+    target = "glsl"
+
+    def __init__(self):
+        super().__init__({"use_operators": True})
+
+
+# flavour -> how the program form is framed (read by templates/glsl/program.glsl.j2)
+FLAVORS = {
+    "330": {"version": "330 core", "es": False, "shadertoy": False},
+    "450": {"version": "450 core", "es": False, "shadertoy": False},
+    "es300": {"version": "300 es", "es": True, "shadertoy": False},
+    "shadertoy": {"version": "", "es": False, "shadertoy": True},
+}

@@ -1,0 +1,126 @@
+"""Printing rules shared by every shader target, on top of sympy's CodePrinter family.
+
+A target printer is `class XPrinter(ShaderPrinterMixin, <sympy printer>)` plus a few class
+attributes. The mixin fixes what sympy gets wrong for shaders: typed float literals for
+every number (`2` -> `2.0`), no `pow` for integer powers (the optimizer already turned
+them into products), constants as literals, every function spelled from
+`functions.FUNCTIONS`, and an implc error (not a driver error) for anything unsupported.
+"""
+
+from __future__ import annotations
+
+import sympy
+from sympy.printing.precedence import PRECEDENCE, precedence
+
+from ..errors import ImplcError
+from ..functions import BY_SYMPY_NAME
+
+
+class ShaderPrinterMixin:
+    target: str = ""
+    float_suffix: str = ""
+
+    def float_literal(self, value: float) -> str:
+        """Shortest decimal that round-trips the float64 value, typed for the target."""
+        value = float(value)
+        if value != value or value in (float("inf"), float("-inf")):
+            raise ImplcError(f"the {self.target} printer cannot print the number {value}")
+        text = repr(value)
+        if "e" not in text and "." not in text:
+            text += ".0"
+        return text + self.float_suffix
+
+    def _print_number(self, expr) -> str:
+        return self.float_literal(float(expr))
+
+    _print_Integer = _print_Rational = _print_Float = _print_number
+    _print_Zero = _print_One = _print_NegativeOne = _print_Half = _print_number
+    _print_NumberSymbol = _print_Pi = _print_Exp1 = _print_number
+
+    def _print_Symbol(self, expr) -> str:
+        return expr.name
+
+    def _print_Mul(self, expr) -> str:
+        coeff, rest = expr.as_coeff_Mul()
+        sign = "-" if coeff < 0 else ""
+        coeff = -coeff if coeff < 0 else coeff
+        num: list[str] = [] if coeff == 1 else [self._print(coeff)]
+        den: list[sympy.Expr] = []
+        prec = PRECEDENCE["Mul"]
+        for factor in sympy.Mul.make_args(rest) if rest != 1 else ():
+            if factor.is_Pow and factor.exp.is_Rational and factor.exp.is_negative:
+                den.append(sympy.Pow(factor.base, -factor.exp, evaluate=factor.exp != -1))
+            else:
+                num.append(self.parenthesize(factor, prec))
+        text = "*".join(num) if num else self.float_literal(1.0)
+        if den:
+            parts = [self.parenthesize(d, prec) for d in den]
+            text += "/" + (parts[0] if len(parts) == 1 else "(" + "*".join(parts) + ")")
+        return sign + text
+
+    def _print_Pow(self, expr) -> str:
+        base, exp = expr.base, expr.exp
+        prec = PRECEDENCE["Mul"]
+        if exp.is_Integer:
+            n = int(exp)
+            if n == 0:
+                return self.float_literal(1.0)
+            body = "*".join([self.parenthesize(base, prec)] * abs(n))
+            if n > 0:
+                return body
+            return f"{self.float_literal(1.0)}/" + (body if abs(n) == 1 else f"({body})")
+        if exp == sympy.Rational(1, 2):
+            return f"sqrt({self._print(base)})"
+        if exp == sympy.Rational(-1, 2):
+            return f"{self.float_literal(1.0)}/sqrt({self._print(base)})"
+        return f"{self.pow_name}({self._print(base)}, {self._print(exp)})"
+
+    pow_name = "pow"
+
+    def _print_table_function(self, expr) -> str:
+        name = type(expr).__name__
+        row = BY_SYMPY_NAME.get(name)
+        if row is None:
+            raise ImplcError(f"function '{name}' cannot be printed for target {self.target}")
+        if name in ("Min", "Max"):
+            return self._fold(getattr(row, self.target), expr.args)
+        if name == "Heaviside":
+            return self.print_step(self._print(expr.args[0]))
+        if name == "DiracDelta":
+            return self.float_literal(0.0)
+        spelled = getattr(row, self.target)
+        if not spelled:
+            raise ImplcError(f"function '{row.name}' has no {self.target} spelling")
+        return f"{spelled}({', '.join(self._print(a) for a in expr.args)})"
+
+    def _fold(self, fname: str, args) -> str:
+        text = self._print(args[-1])
+        for a in reversed(args[:-1]):
+            text = f"{fname}({self._print(a)}, {text})"
+        return text
+
+    def print_step(self, arg: str) -> str:
+        """Heaviside(x): 1 for x >= 0, else 0 (the derivative of max by branch)."""
+        return f"step({self.float_literal(0.0)}, {arg})"
+
+    def emptyPrinter(self, expr) -> str:  # noqa: N802 (sympy's name)
+        raise ImplcError(f"'{type(expr).__name__}' cannot be printed for target {self.target}")
+
+    def parenthesize(self, item, level, strict=False) -> str:
+        text = self._print(item)
+        if precedence(item) < level or (not strict and precedence(item) <= level and
+                                         item.is_Add):
+            return f"({text})"
+        if text.startswith("-") and level >= PRECEDENCE["Mul"]:
+            return f"({text})"
+        return text
+
+
+def _install_table_functions() -> None:
+    """Route every node class of the function table through the one table printer."""
+    for name in BY_SYMPY_NAME:
+        setattr(ShaderPrinterMixin, f"_print_{name}", ShaderPrinterMixin._print_table_function)
+    ShaderPrinterMixin._print_Function = ShaderPrinterMixin._print_table_function
+
+
+_install_table_functions()

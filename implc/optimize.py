@@ -1,0 +1,167 @@
+"""Turn derived expressions into a straight-line `Program` a printer can emit.
+
+Three passes, all deterministic:
+1. joint CSE of every output of one shader function (sympy `cse`, canonical order,
+   temporaries named t0, t1, ... in order of definition);
+2. integer powers to products: x**4 becomes `x_2 = x*x; x_4 = x_2*x_2`, shared across the
+   whole function (GLSL/WGSL `pow` is undefined or rejected for negative bases);
+3. op counting with one cost model, before (each output alone, powers as repeated
+   multiplication) and after (the optimized program), so `implc show` can report both.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import sympy
+
+
+@dataclass(frozen=True)
+class Program:
+    """Straight-line code: assignments in order, then output expressions."""
+
+    inputs: tuple[sympy.Symbol, ...]
+    assignments: tuple[tuple[sympy.Symbol, sympy.Expr], ...]
+    outputs: tuple[sympy.Expr, ...]
+    ops_before: int
+    ops_after: int
+
+
+def optimize(outputs: Sequence[sympy.Expr], inputs: Sequence[sympy.Symbol]) -> Program:
+    """Jointly CSE `outputs`, rewrite integer powers as products and count operations."""
+    outputs = tuple(outputs)
+    inputs = tuple(inputs)
+    before = sum(count_ops(o) for o in outputs)
+    temps = sympy.numbered_symbols("c", real=True)
+    replacements, reduced = sympy.cse(list(outputs), symbols=temps, order="canonical")
+    assignments, reduced, powers = _name_powers(list(replacements), list(reduced))
+    assignments, reduced = _drop_aliases(assignments, reduced)
+    assignments, reduced, powers = _renumber(assignments, reduced, powers)
+    assignments = _insert_power_chains(assignments, powers, inputs)
+    after = sum(count_ops(v) for _, v in assignments) + sum(count_ops(o) for o in reduced)
+    return Program(inputs, tuple(assignments), tuple(reduced), before, after)
+
+
+def _power_symbol(base: sympy.Symbol, n: int) -> sympy.Symbol:
+    return sympy.Symbol(f"{base.name}_{n}", real=True)
+
+
+def _name_powers(assignments, outputs):
+    """Replace every b**n (integer |n| >= 2) by a symbol b_n; say which powers are needed.
+
+    A compound base that CSE left in place (used once) is first named itself (h0, h1, ...).
+    """
+    needed: dict[sympy.Symbol, set[int]] = {}
+    hoisted: list[tuple[sympy.Symbol, sympy.Expr]] = []
+    hoist_names = sympy.numbered_symbols("h", real=True)
+    hoist_of: dict[sympy.Expr, sympy.Symbol] = {}
+
+    def visit(node: sympy.Expr) -> sympy.Expr:
+        if node.is_Pow and node.exp.is_Integer and abs(int(node.exp)) >= 2:
+            n = int(node.exp)
+            base = visit(node.base)
+            if not base.is_Symbol:
+                if base not in hoist_of:
+                    hoist_of[base] = next(hoist_names)
+                    hoisted.append((hoist_of[base], base))
+                base = hoist_of[base]
+            needed.setdefault(base, set()).add(abs(n))
+            sym = _power_symbol(base, abs(n))
+            return sym if n > 0 else sympy.Pow(sym, -1)
+        if node.is_Atom or not node.args:
+            return node
+        return node.func(*(visit(a) for a in node.args))
+
+    new_assignments = []
+    for sym, value in assignments:
+        value = visit(value)
+        new_assignments.extend(hoisted)  # bases first found here are defined before use
+        hoisted.clear()
+        new_assignments.append((sym, value))
+    new_outputs = [visit(o) for o in outputs]
+    new_assignments.extend(hoisted)
+    return new_assignments, new_outputs, needed
+
+
+def _drop_aliases(assignments, outputs):
+    """Remove copies such as `c0 = y_2` (CSE named a power the power pass also named)."""
+    alias: dict[sympy.Symbol, sympy.Expr] = {}
+    kept = []
+    for sym, value in assignments:
+        value = value.xreplace(alias) if alias else value
+        if value.is_Symbol:
+            alias[sym] = value
+        else:
+            kept.append((sym, value))
+    return kept, [o.xreplace(alias) if alias else o for o in outputs]
+
+
+def _renumber(assignments, outputs, powers):
+    """Name temporaries t0, t1, ... in order of definition, and their powers t0_2, ..."""
+    rename: dict[sympy.Symbol, sympy.Symbol] = {}
+    for k, (sym, _) in enumerate(assignments):
+        rename[sym] = sympy.Symbol(f"t{k}", real=True)
+    for base, exps in powers.items():
+        if base in rename:
+            for n in exps:
+                rename[_power_symbol(base, n)] = _power_symbol(rename[base], n)
+    assignments = [(rename[s], v.xreplace(rename)) for s, v in assignments]
+    outputs = [o.xreplace(rename) for o in outputs]
+    powers = {rename.get(b, b): exps for b, exps in powers.items()}
+    return assignments, outputs, powers
+
+
+def _insert_power_chains(assignments, powers, inputs):
+    """Define each needed b_n right after b: b_2 = b*b, b_3 = b*b_2, b_4 = b_2*b_2."""
+    ordered = []
+    for b in inputs:
+        ordered.extend(_power_chain(b, powers.get(b, set())))
+    for sym, value in assignments:
+        ordered.append((sym, value))
+        ordered.extend(_power_chain(sym, powers.get(sym, set())))
+    return ordered
+
+
+def _power_chain(base: sympy.Symbol, exponents: set[int]):
+    """Assignments computing base**n for each n by halving (unevaluated products)."""
+    have: dict[int, sympy.Expr] = {1: base}
+    chain: list[tuple[sympy.Symbol, sympy.Expr]] = []
+
+    def build(n: int) -> sympy.Expr:
+        if n not in have:
+            half = n // 2
+            lo, hi = build(half), build(n - half)
+            sym = _power_symbol(base, n)
+            chain.append((sym, sympy.Mul(lo, hi, evaluate=False)))
+            have[n] = sym
+        return have[n]
+
+    for n in sorted(exponents):
+        build(n)
+    return chain
+
+
+def count_ops(expr: sympy.Expr) -> int:
+    """Arithmetic operations to evaluate `expr` as a tree, b**n costing n-1 products.
+
+    Add/Mul with k operands cost k-1, a negation or division 1, a function call 1.
+    """
+    if expr.is_Atom:
+        return 0
+    if expr.is_Pow:
+        n = expr.exp
+        inner = count_ops(expr.base)
+        if n.is_Integer:
+            k = abs(int(n))
+            return inner + max(k - 1, 0) + (1 if int(n) < 0 else 0)
+        return inner + count_ops(n) + 1
+    if expr.is_Mul:
+        args = expr.args
+        cost = sum(count_ops(a) for a in args) + len(args) - 1
+        if args[0] == -1:
+            cost -= 1  # -1*x is a negation: one op, already counted as the product
+        return cost
+    if expr.is_Add:
+        return sum(count_ops(a) for a in expr.args) + len(expr.args) - 1
+    return sum(count_ops(a) for a in expr.args) + 1

@@ -1,0 +1,110 @@
+"""Run a generated GLSL program headlessly with moderngl (EGL; Mesa llvmpipe here).
+
+The fragment shader writes two float targets: colour and aux (hit, t, steps, |S|).
+Rows are flipped on readback so row 0 is the top of the image, like every runner.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from functools import lru_cache
+
+import numpy as np
+
+from ..errors import ToolError
+from .result import RenderResult
+from .scene import View
+
+TRIANGLES = 0x0004  # GL_TRIANGLES
+
+
+@lru_cache(maxsize=1)
+def context():
+    """One standalone EGL context per process (creating one costs ~0.1 s)."""
+    try:
+        import moderngl
+    except ImportError as err:  # pragma: no cover - depends on the install
+        raise ToolError("moderngl is not installed (run `make setup`)") from err
+    os.environ.setdefault("XDG_RUNTIME_DIR", "/tmp")
+    try:
+        return moderngl.create_standalone_context(backend="egl", require=330)
+    except Exception as err:  # moderngl raises plain Exception subclasses
+        raise ToolError(f"cannot create a headless OpenGL context (EGL): {err}") from err
+
+
+def renderer_name() -> str:
+    return str(context().info.get("GL_RENDERER", "unknown"))
+
+
+class GlRunner:
+    """A compiled program and its framebuffer; `frame()` renders and reads back once."""
+
+    def __init__(self, fragment: str, vertex: str, view: View, width: int, height: int):
+        ctx = context()
+        try:
+            self.program = ctx.program(vertex_shader=vertex, fragment_shader=fragment)
+        except Exception as err:
+            raise ToolError(f"the GL driver rejected the shader: {err}") from err
+        self.width, self.height = width, height
+        self.vao = ctx.vertex_array(self.program, [])
+        self.color = ctx.texture((width, height), 4, dtype="f4")
+        self.aux = ctx.texture((width, height), 4, dtype="f4")
+        self.fbo = ctx.framebuffer(color_attachments=[self.color, self.aux])
+        uniforms = {
+            "u_resolution": (float(width), float(height)),
+            "u_eye": view.eye,
+            "u_target": view.target,
+            "u_up": view.up,
+            "u_fov_y": view.fov_y_deg,
+            "u_clip_center": view.clip_center,
+            "u_clip_radius": view.clip_radius,
+        }
+        for name, value in uniforms.items():
+            if name in self.program:
+                self.program[name].value = value
+
+    def draw(self) -> None:
+        """Render one frame and wait for it (glFinish), without reading it back."""
+        self.fbo.use()
+        self.fbo.viewport = (0, 0, self.width, self.height)
+        self.vao.render(mode=TRIANGLES, vertices=3)
+        context().finish()
+
+    def read(self) -> RenderResult:
+        shape = (self.height, self.width, 4)
+        color = np.frombuffer(self.fbo.read(components=4, attachment=0, dtype="f4"), np.float32)
+        aux = np.frombuffer(self.fbo.read(components=4, attachment=1, dtype="f4"), np.float32)
+        color = color.reshape(shape)[::-1]
+        aux = aux.reshape(shape)[::-1]
+        return RenderResult(
+            color=np.ascontiguousarray(color[..., :3]),
+            hit=aux[..., 0] > 0.5,
+            t=np.ascontiguousarray(aux[..., 1]),
+            steps=np.ascontiguousarray(aux[..., 2]),
+            residual=np.ascontiguousarray(aux[..., 3]),
+        )
+
+    def frame(self) -> RenderResult:
+        start = time.perf_counter()
+        self.draw()
+        result = self.read()
+        result.timing["frame"] = time.perf_counter() - start
+        return result
+
+    def release(self) -> None:
+        for obj in (self.fbo, self.color, self.aux, self.vao, self.program):
+            obj.release()
+
+
+def render_gl(fragment: str, vertex: str, view: View, width: int, height: int) -> RenderResult:
+    """Compile, render one frame and read it back; timing holds compile and frame seconds."""
+    start = time.perf_counter()
+    runner = GlRunner(fragment, vertex, view, width, height)
+    compiled = time.perf_counter()
+    try:
+        result = runner.frame()
+    finally:
+        runner.release()
+    result.timing["compile"] = compiled - start
+    return result

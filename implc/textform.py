@@ -1,0 +1,31 @@
+"""Print a sympy tree back as an equation implc itself parses (for headers and JSON)."""
+
+from __future__ import annotations
+
+import sympy
+from sympy.printing.str import StrPrinter
+
+_NAMES = {"Abs": "abs", "Min": "min", "Max": "max"}
+
+
+class _EquationPrinter(StrPrinter):
+    def _print_Function(self, expr):
+        name = _NAMES.get(type(expr).__name__, type(expr).__name__)
+        return f"{name}({', '.join(self._print(a) for a in expr.args)})"
+
+    _print_Abs = _print_Min = _print_Max = _print_Function
+
+    def _print_Exp1(self, expr):
+        return "e"
+
+    def _print_Pi(self, expr):
+        return "pi"
+
+    def _print_Pow(self, expr, rational=False):
+        text = super()._print_Pow(expr, rational)
+        return text.replace("**", "^")
+
+
+def to_text(expr: sympy.Expr) -> str:
+    """`expr` as `... = 0` in implc's input language (deterministic, `^` for powers)."""
+    return _EquationPrinter({"order": "lex"}).doprint(expr) + " = 0"
