@@ -40,7 +40,9 @@ MAX_RAY_POLYNOMIAL_DEGREE = 12
 
 # Root acceptance for polynomials, in u = s / L (so the interval is [0, 1]) with the
 # coefficients scaled to max |a_k| = 1:
-ROOT_TOL = 1e-9  # accept u when |F(u)| <= ROOT_TOL * sum_k |a_k| u^k (F's rounding scale)
+ROOT_TOL = 1e-12  # accept u when |F(u)| <= ROOT_TOL * sum_k |a_k| u^k: float64 rounding of
+#                   F is ~1e-16 of that scale, so this leaves 10^4 for the rounding of the
+#                   coefficients; 1e-9 accepted visible near misses by the double lines
 IMAG_TOL = 1e-3  # eigenvalues with |Im u| <= IMAG_TOL are candidates; a double root
 #                  splits into a complex pair with |Im u| ~ 1e-8, a triple one ~ 1e-5
 LEAD_TOL = 1e-13  # leading coefficients below this (relative) are dropped, per ray
@@ -58,7 +60,8 @@ DENSE_CHUNK_VALUES = 1 << 20  # rays x samples per batch (the evaluator keeps ev
 def render_reference(
     expr: sympy.Expr, view: View, width: int, height: int, *, samples: int = DENSE_SAMPLES
 ) -> RenderResult:
-    """Render S = 0 with the shared camera and shading, hits from exact roots (float64).
+    """Render S = 0 with the shared camera and shading; hits are exact float64 roots for
+    polynomial S and come from the (inexact) dense search otherwise.
 
     `samples` is used only by the dense search of non-polynomial surfaces; `steps` reports
     it for every pixel that entered the clip sphere (0 for polynomial surfaces).
@@ -98,7 +101,7 @@ def render_reference(
     residual[hit] = np.abs(_on(expr, env, hit.sum()))
 
     shape = (height, width)
-    color = shade(grad.reshape(height, width, 3), dirs.reshape(height, width, 3), hit.reshape(shape))
+    color = shade(grad.reshape(*shape, 3), dirs.reshape(*shape, 3), hit.reshape(shape))
     return RenderResult(
         color=color.astype(np.float32),
         hit=hit.reshape(shape),
@@ -168,8 +171,7 @@ def first_roots(
     for lo in range(0, n, POLYNOMIAL_CHUNK):
         part = slice(lo, lo + POLYNOMIAL_CHUNK)
         entry = origins[part] + t_near[part, None] * dirs[part]
-        env = dict(zip(ORIGIN, entry.T, strict=True)) | dict(zip(DIRECTION, dirs[part].T,
-                                                                 strict=True))
+        env = dict(zip((*ORIGIN, *DIRECTION), (*entry.T, *dirs[part].T), strict=True))
         rows = entry.shape[0]
         coeffs = np.stack([_on(c, env, rows) for c in coefficients], axis=-1)
         found, s = first_root_in_interval(coeffs, t_far[part] - t_near[part])
@@ -192,10 +194,13 @@ def first_root_in_interval(
     - each candidate is polished twice in float64 with the full polynomial: Newton on F
       (a crossing root) and Newton on F' (the touching point of a double root);
     - a polished u in [0, 1] is a root when |F(u)| <= ROOT_TOL * sum_k |a_k| u^k. So a
-      tangential ray counts as a hit, and so does a ray missing the surface by less than
-      about sqrt(ROOT_TOL) of the interval, which float64 cannot tell from a touch anyway.
+      tangential ray counts as a hit, and so does a ray that misses the surface with
+      min |F| that small (near a tangent point, by about sqrt(ROOT_TOL) ~ 1e-6 of the
+      interval), which float64 rounding of the coefficients cannot tell from a touch.
+    Near a double root the hit is accurate to about sqrt(ROOT_TOL) of the interval; at
+    simple roots to float64 rounding.
     The first accepted u is the hit. A polynomial that vanishes identically (the ray lies
-    in the surface) hits at s = 0.
+    in the surface) hits at s = 0; an empty interval (length <= 0) never hits.
     """
     coeffs = np.asarray(coeffs, np.float64)
     lengths = np.asarray(lengths, np.float64)
@@ -213,8 +218,8 @@ def first_root_in_interval(
     for u in (crossing, touching):
         np.fmin.at(first, rows, np.where(_is_root(a[rows], u), u, np.nan))
     first[size == 0.0] = 0.0
-    found = np.isfinite(first)
-    return found, np.where(found, first * lengths, 0.0)
+    found = np.isfinite(first) & (lengths > 0.0)
+    return found, np.where(found, first, 0.0) * lengths
 
 
 def dense_first_roots(
