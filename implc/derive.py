@@ -46,7 +46,7 @@ class Derivatives:
 
     @cached_property
     def directional(self) -> sympy.Expr:
-        return sympy.Add(*(g * d for g, d in zip(self.gradient, DIRECTION)))
+        return sympy.Add(*(g * d for g, d in zip(self.gradient, DIRECTION, strict=True)))
 
     @cached_property
     def second_directional(self) -> sympy.Expr:

@@ -14,7 +14,7 @@ from functools import lru_cache
 import jinja2
 import sympy
 
-from .backends import Target, get_target
+from .backends import get_target
 from .derive import Derivatives
 from .errors import InputError
 from .methods import Constants, Method, get_method
@@ -53,6 +53,12 @@ def environment() -> jinja2.Environment:
 
 def build_functions(expr: sympy.Expr, method: Method) -> dict[str, Program]:
     """Derive and optimize every function the method needs (jointly CSE'd per function)."""
+    return dict(_build_functions(expr, method.name))
+
+
+@lru_cache(maxsize=32)
+def _build_functions(expr: sympy.Expr, method_name: str) -> tuple[tuple[str, Program], ...]:
+    method = get_method(method_name)
     derivatives = Derivatives(expr)
     programs: dict[str, Program] = {}
     for name, quantities in method.all_functions().items():
@@ -60,7 +66,7 @@ def build_functions(expr: sympy.Expr, method: Method) -> dict[str, Program]:
         needs_direction = any(q in ("dS", "d2S") for q in quantities)
         inputs = POINT + DIRECTION if needs_direction else POINT
         programs[name] = optimize(outputs, inputs)
-    return programs
+    return tuple(programs.items())
 
 
 def print_function(name: str, program: Program, printer) -> ShaderFunction:
@@ -81,6 +87,7 @@ def emit(
     flavor: str | None = None,
     emit: str = "program",
     prefix: str = "",
+    precision: str | None = None,
 ) -> str:
     """The complete shader text for `surface` (deterministic, byte for byte)."""
     tgt = get_target(target)
@@ -88,12 +95,16 @@ def emit(
     constants = constants or meth.defaults
     flavor = flavor or tgt.default_flavor
     if flavor not in tgt.flavors:
-        raise InputError(f"unknown {target} flavor '{flavor}'; choose from {', '.join(tgt.flavors)}")
+        choices = ", ".join(tgt.flavors)
+        raise InputError(f"unknown {target} flavor '{flavor}'; choose from {choices}")
     if emit not in EMITS:
         raise InputError(f"unknown emit '{emit}'; choose from {', '.join(EMITS)}")
     if not set(prefix) <= PREFIX_CHARS or (prefix and prefix[0].isdigit()):
         raise InputError(f"--prefix must be letters, digits and '_' (got '{prefix}')")
-    printer = tgt.printer()
+    precision = precision or "float"
+    if precision not in tgt.precisions:
+        raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
+    printer = tgt.printer(precision) if len(tgt.precisions) > 1 else tgt.printer()
     functions = {
         name: print_function(name, program, printer)
         for name, program in build_functions(surface.expr, meth).items()
@@ -108,6 +119,7 @@ def emit(
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
         "flavor_name": flavor,
+        "precision": precision,
         "shading": _print_shading(printer),
         "view": _print_view(surface.view, printer),
     }

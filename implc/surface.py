@@ -68,7 +68,7 @@ def load_surface(
     spec: str | None = None,
     equation: str | None = None,
     params: Sequence[str] = (),
-    limits: Limits = Limits(),
+    limits: Limits | None = None,
 ) -> Surface:
     """A surface from a TOML path, a bundled example name, or `-e` equation text.
 
@@ -76,6 +76,7 @@ def load_surface(
     """
     if (spec is None) == (equation is None):
         raise InputError("give either a surface (file or example name) or -e EQUATION")
+    limits = limits or Limits()
     overrides = _parse_param_args(params)
     if equation is not None:
         source = Source("<equation>", equation)
@@ -153,7 +154,8 @@ def _view(name: str, table) -> View:
     known = {"radius", "center", "eye", "target", "up", "fov"}
     unknown = sorted(set(table) - known)
     if unknown:
-        raise InputError(f"{name}: unknown [view] key '{unknown[0]}' (known: {', '.join(sorted(known))})")
+        choices = ", ".join(sorted(known))
+        raise InputError(f"{name}: unknown [view] key '{unknown[0]}' (known: {choices})")
     default = View()
 
     def number(key: str, fallback: float, low: float, high: float) -> float:

@@ -15,6 +15,13 @@ class _EquationPrinter(StrPrinter):
 
     _print_Abs = _print_Min = _print_Max = _print_Function
 
+    def _print_Rational(self, expr):
+        """Short fractions stay exact (`9/4`); long ones (from decimal parameters such as
+        phi = 1.618033988749895) print as the shortest decimal of their float value."""
+        if expr.q > 1000:
+            return repr(float(expr))
+        return super()._print_Rational(expr)
+
     def _print_Exp1(self, expr):
         return "e"
 

@@ -88,16 +88,90 @@ def _locate(output: str, name: str, prelude: int) -> str:
     return re.sub(r"((?:ERROR|WARNING): )(?:0|" + re.escape(name) + r"):(\d+):", shift, output)
 
 
+def validate_opencl(text: str, name: str = "shader.cl") -> Verdict:
+    """Build OpenCL C with the OpenCL driver (PoCL here) through pyopencl.
+
+    A program and a library emit both build as they are (a program needs no kernel), so
+    line numbers are the user's. A double-precision source on a device without
+    cl_khr_fp64 fails here, with the reason, rather than with the driver's type errors.
+    """
+    from .render.cl_runner import FP64, build, device
+
+    dev = device()
+    tool = f"OpenCL build, {dev.name}"
+    pragma = re.search(r"^[ \t]*#[ \t]*pragma[ \t]+OPENCL[ \t]+EXTENSION[ \t]+" + FP64, text, re.M)
+    if pragma and not dev.has_fp64:
+        line = text.count("\n", 0, pragma.start()) + 1
+        message = (f"{name}:{line}:1: error: double precision needs {FP64}, which this "
+                   "device does not support")
+        return Verdict(False, tool, message)
+    built = build(text)
+    return Verdict(built.program is not None, tool, _locate_cl(built.log, name))
+
+
+def _locate_cl(log: str, name: str) -> str:
+    """`error: /tmp/.../tempfile_x.cl:5:25: msg` (PoCL) or `<source>:5:25: error: msg`
+    (clang) -> `name:5:25: error: msg`."""
+    log = re.sub(r"^(error|warning|note|remark): [^\s:]+:(\d+):(\d+): ",
+                 lambda m: f"{name}:{m.group(2)}:{m.group(3)}: {m.group(1)}: ", log, flags=re.M)
+    return re.sub(r"^(?:<source>|[^\s:]+\.cl):(\d+):(\d+): ", lambda m: f"{name}:{m.group(1)}:"
+                  f"{m.group(2)}: ", log, flags=re.M)
+
+
+WGSL_LABEL = "implc-shader.wgsl"  # the name naga sees; replaced by the user's in messages
+
+
+def validate_wgsl(text: str, name: str = "shader.wgsl") -> Verdict:
+    """Validate WGSL with naga: inside wgpu (the shader module an engine would create, on
+    the software adapter) and with the `naga` CLI when it is on PATH; both must accept.
+    A library emit needs no harness: naga validates a module without entry points.
+    Messages are naga's own (`┌─ name:line:col` and a caret), pointing at `name`."""
+    from .render.wgpu_runner import device
+
+    dev = device()  # a missing wgpu or adapter is a ToolError (exit 4)
+    import wgpu
+
+    tools, failures = ["naga (wgpu)"], []
+    try:
+        dev.create_shader_module(code=text, label=WGSL_LABEL)
+    except wgpu.GPUError as err:
+        # drop wgpu's "Validation Error / Caused by / In wgpuDeviceCreateShaderModule" frame
+        message = re.sub(r"(?s)^.*?In wgpuDeviceCreateShaderModule[^\n]*\n", "", str(err))
+        # parse errors name the source `wgsl`, validation errors by its label
+        failures.append(re.sub(r"(─ )wgsl:(?=\d)", rf"\g<1>{WGSL_LABEL}:", message).strip())
+    naga = shutil.which("naga")
+    if naga is not None:
+        tools.append("naga CLI")
+        try:
+            proc = subprocess.run(
+                [naga, "--input-kind", "wgsl", "--stdin-file-path", WGSL_LABEL],
+                input=text, capture_output=True, text=True, timeout=120,
+                env={**os.environ, "NO_COLOR": "1"},
+            )
+        except subprocess.TimeoutExpired:
+            raise ToolError("naga did not finish within 120 s") from None
+        if proc.returncode != 0:
+            # one report is enough when both reject: the CLI's is the plainer text
+            failures = [(proc.stdout + proc.stderr).strip()]
+    messages = "\n".join(failures).replace(WGSL_LABEL, name)
+    return Verdict(not failures, " + ".join(tools), messages)
+
+
+# target -> validator(text, name); file extension -> target
+VALIDATORS = {"glsl": validate_glsl, "opencl": validate_opencl, "wgsl": validate_wgsl}
+EXTENSIONS = {**{ext: "glsl" for ext in GLSL_STAGES}, ".cl": "opencl", ".wgsl": "wgsl"}
+
+
 def validate_file(path: Path) -> Verdict:
-    """Validate a shader file by its extension."""
-    text = path.read_text(encoding="utf-8")
-    suffix = path.suffix
-    if suffix in GLSL_STAGES:
-        return validate_glsl(text, str(path))
-    raise ToolError(f"{path}: unknown shader extension '{suffix}' (known: .frag .vert .glsl)")
+    """Validate a shader file, choosing the language by its extension."""
+    target = EXTENSIONS.get(path.suffix)
+    if target is None:
+        known = " ".join(sorted(EXTENSIONS))
+        raise ToolError(f"{path}: unknown shader extension '{path.suffix}' (known: {known})")
+    return VALIDATORS[target](path.read_text(encoding="utf-8"), str(path))
 
 
 def validate_text(text: str, target: str, name: str) -> Verdict:
-    if target == "glsl":
-        return validate_glsl(text, name)
-    raise ToolError(f"no validator for target '{target}'")
+    if target not in VALIDATORS:
+        raise ToolError(f"no validator for target '{target}'")
+    return VALIDATORS[target](text, name)

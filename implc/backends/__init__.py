@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 
 from .glsl import FLAVORS as GLSL_FLAVORS
 from .glsl import GlslPrinter
+from .opencl import OpenclPrinter
+from .wgsl import WgslPrinter
 
 
 @dataclass(frozen=True)
@@ -18,10 +20,15 @@ class Target:
     flavors: dict[str, dict] = field(default_factory=lambda: {"default": {}})
     default_flavor: str = "default"
     vector_types: tuple[str, str, str] = ("float", "vec2", "vec3")
+    precisions: tuple[str, ...] = ("float",)
 
 
 TARGETS: dict[str, Target] = {
     "glsl": Target("glsl", "frag", GlslPrinter, GLSL_FLAVORS, "330"),
+    "wgsl": Target("wgsl", "wgsl", WgslPrinter, vector_types=("f32", "vec2<f32>", "vec3<f32>")),
+    # double precision: templates/opencl/ spell double/double2/double3 from `precision`
+    "opencl": Target("opencl", "cl", OpenclPrinter, vector_types=("float", "float2", "float3"),
+                     precisions=("float", "double")),
 }
 
 

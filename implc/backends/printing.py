@@ -59,6 +59,8 @@ class ShaderPrinterMixin:
         return sign + text
 
     def _print_Pow(self, expr) -> str:
+        if expr.is_number:  # a constant such as sqrt(2): fold it
+            return self._print_constant(expr)
         base, exp = expr.base, expr.exp
         prec = PRECEDENCE["Mul"]
         if exp.is_Integer:
@@ -77,7 +79,15 @@ class ShaderPrinterMixin:
 
     pow_name = "pow"
 
+    def _print_constant(self, expr) -> str:
+        try:
+            return self.float_literal(float(expr))
+        except (TypeError, OverflowError):
+            raise ImplcError(f"the constant {expr} is not a finite real number") from None
+
     def _print_table_function(self, expr) -> str:
+        if expr.is_number:
+            return self._print_constant(expr)
         name = type(expr).__name__
         row = BY_SYMPY_NAME.get(name)
         if row is None:

@@ -95,16 +95,3 @@ class GlRunner:
     def release(self) -> None:
         for obj in (self.fbo, self.color, self.aux, self.vao, self.program):
             obj.release()
-
-
-def render_gl(fragment: str, vertex: str, view: View, width: int, height: int) -> RenderResult:
-    """Compile, render one frame and read it back; timing holds compile and frame seconds."""
-    start = time.perf_counter()
-    runner = GlRunner(fragment, vertex, view, width, height)
-    compiled = time.perf_counter()
-    try:
-        result = runner.frame()
-    finally:
-        runner.release()
-    result.timing["compile"] = compiled - start
-    return result

@@ -1,0 +1,469 @@
+"""The Table 1 harness: speed and accuracy of every marcher against the exact reference.
+
+For each configuration x surface x method: one warm-up frame, then `frames` timed frames
+(each `runner.frame()` renders, waits for completion and reads back; the methods of one
+surface take their frames in turns, see `time_interleaved`), reported as the
+median frames per second and as the ratio to `taylor`'s fps in the same run (absolute fps
+depend on the machine; the ratio is what compares across machines). The last timed frame
+is compared with the exact CPU reference (computed once per surface, same size and
+camera): SSIM, false / missed hits, wrong-root pixels, mean march steps per pixel.
+
+Configurations:
+- `paper`: each method's defaults, the paper's Table 1 constants (b = 0.01; hessian
+  b = 0.002; tau1 = tau2 = tau3 = 0.01);
+- `equal`: the same base step for every method (`equal_step`, default 0.002 = the paper's
+  hessian step), so accuracy differences come from the root test, not the step;
+- `taylor2`: hessian and hessian-approx with `taylor2 = "consistent"` (h^2/8, F''(t1) in r)
+  at the paper's constants; its fps ratio is taken against `paper`'s taylor.
+
+Outputs in the directory: table.md, table.json, figure.png (the first configuration,
+`paper` by default, laid out like the paper's Fig. 2), figure-<config>.png for the others,
+and renders/<surface>-<method>-<config>.png (+ JSON sidecar; + EXR with `exr=True`) and
+renders/<surface>-reference.png.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TextIO
+
+from . import __version__
+from .errors import InputError
+from .fileio import write_atomic, write_with
+from .methods import METHODS
+from .metrics import T_TOL, compare
+from .render.result import RenderResult
+from .render.run import BACKENDS, metadata, open_runner
+from .surface import Surface
+
+# Table 1's columns in the paper's order, then `sign` (not in the paper; informative).
+DEFAULT_METHODS: tuple[str, ...] = ("taylor", "curvature", "hessian-approx", "hessian", "sign")
+CONFIG_NAMES: tuple[str, ...] = ("paper", "equal", "taylor2")
+EQUAL_STEP = 0.002  # the paper's hessian step, given to every method in `equal`
+TILE = 256  # figure tile size in pixels
+
+# The paper's Table 1 (NVidia Quadro P5000, 1024x1024): fps and SSIM as printed. The
+# Hessian-exact column has no SSIM: it is the paper's own ground truth (at a tiny step).
+PAPER_TABLE1: dict[str, dict[str, tuple[float, float | None]]] = {
+    "cross-cap": {"taylor": (592, 0.9628), "curvature": (150, 0.9964),
+                  "hessian-approx": (152, 0.9991), "hessian": (23, None)},
+    "miter": {"taylor": (580, 0.9574), "curvature": (154, 0.9957),
+              "hessian-approx": (158, 0.9991), "hessian": (24, None)},
+    "steiner": {"taylor": (416, 0.9214), "curvature": (151, 0.9667),
+                "hessian-approx": (88, 0.9878), "hessian": (25, None)},
+}
+
+
+@dataclass(frozen=True)
+class BenchConfig:
+    """A set of constant overrides applied to some methods, and its fps baseline."""
+
+    name: str
+    title: str
+    overrides: Mapping[str, object]
+    methods: tuple[str, ...] | None = None  # None: every selected method
+    baseline: str = ""  # configuration whose taylor fps divides this one's; "" = itself
+
+    def applies_to(self, selected: Sequence[str]) -> list[str]:
+        return [m for m in selected if self.methods is None or m in self.methods]
+
+
+def make_configs(names: Sequence[str], equal_step: float = EQUAL_STEP) -> list[BenchConfig]:
+    """The named configurations, in the order given (see the module docstring)."""
+    known = {
+        "paper": BenchConfig(
+            "paper", "the paper's constants: b = 0.01 (hessian 0.002), tau1 = tau2 = tau3 = 0.01",
+            {}),
+        "equal": BenchConfig(
+            "equal", f"equal step: b = {equal_step:g} for every method, tau as in the paper",
+            {"step": equal_step}),
+        "taylor2": BenchConfig(
+            "taylor2", "Eq. 4 consistent (h^2/8, F''(t1) in r) at the paper's constants",
+            {"taylor2": "consistent"}, methods=("hessian", "hessian-approx"), baseline="paper"),
+    }
+    configs = []
+    for name in names:
+        if name not in known:
+            raise InputError(f"unknown configuration '{name}'; choose from {', '.join(known)}")
+        if name not in (c.name for c in configs):
+            configs.append(known[name])
+    return configs
+
+
+@dataclass
+class Cell:
+    """One surface x method x configuration measurement."""
+
+    fps: float
+    frame_seconds: list[float]
+    setup_seconds: float
+    metrics: dict
+    render: str  # PNG path relative to the output directory
+    ratio_to_taylor: float | None = None
+
+    def as_json(self) -> dict:
+        return {
+            "fps": self.fps,
+            "ratio_to_taylor": self.ratio_to_taylor,
+            "frame_seconds": self.frame_seconds,
+            "setup_seconds": self.setup_seconds,
+            **self.metrics,
+            "render": self.render,
+        }
+
+
+@dataclass
+class BenchRun:
+    """Everything measured; `as_json()` is table.json."""
+
+    size: int
+    frames: int
+    backend: str
+    methods: list[str]
+    configs: list[BenchConfig]
+    surfaces: dict[str, Surface]
+    machine: dict
+    reference_seconds: dict[str, float] = field(default_factory=dict)
+    cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)  # (config, surf, m)
+    tiles: dict[tuple[str, str, str], object] = field(default_factory=dict)  # PIL thumbnails
+
+    def config_methods(self, config: BenchConfig) -> list[str]:
+        return config.applies_to(self.methods)
+
+    def as_json(self) -> dict:
+        return {
+            "implc": __version__,
+            "machine": self.machine,
+            "backend": self.backend,
+            "size": self.size,
+            "frames": self.frames,
+            "warmup_frames": 1,
+            "t_tol": T_TOL,
+            "methods": self.methods,
+            "surfaces": {
+                key: {"name": s.name, "equation": s.equation,
+                      "camera": s.view.camera_json(self.size, self.size),
+                      "clip": s.view.clip_json(),
+                      "reference_seconds": self.reference_seconds.get(key)}
+                for key, s in self.surfaces.items()
+            },
+            "configs": [
+                {
+                    "name": c.name,
+                    "title": c.title,
+                    "baseline": c.baseline or c.name,
+                    "constants": {m: METHODS[m].constants(**c.overrides).as_dict()
+                                  for m in self.config_methods(c)},
+                    "results": {
+                        key: {m: self.cells[c.name, key, m].as_json()
+                              for m in self.config_methods(c) if (c.name, key, m) in self.cells}
+                        for key in self.surfaces
+                    },
+                }
+                for c in self.configs
+            ],
+            "paper_table1": {k: {m: {"fps": v[0], "ssim": v[1]} for m, v in row.items()}
+                             for k, row in PAPER_TABLE1.items()},
+        }
+
+
+def machine_info(backend: str) -> dict:
+    """What the fps depend on: the renderer (llvmpipe here), the CPU and its core count."""
+    info = {
+        "cpu_count": os.cpu_count(),
+        "cpu_model": _cpu_model(),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "load_average_start": _load_average(),  # other work on the machine skews fps
+    }
+    if backend == "gl":
+        from .render.gl import renderer_name
+
+        info["gl_renderer"] = renderer_name()
+    return info
+
+
+def _load_average() -> list[float] | None:
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        return None
+
+
+def _cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text(encoding="utf-8").splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def time_interleaved(runners: Sequence, frames: int) -> tuple[list[list[float]], list]:
+    """Seconds of each runner's `frames` frames after one untimed warm-up each, and each
+    runner's last frame.
+
+    The warm-up absorbs first-use costs (driver shader compilation, allocation). Frames
+    are taken in rounds (one frame of every runner per round), so a burst of load from
+    another process on a shared machine hits every method alike instead of one of them,
+    which keeps the fps ratios fair.
+    """
+    for runner in runners:
+        runner.frame()
+    seconds: list[list[float]] = [[] for _ in runners]
+    last: list = [None] * len(runners)
+    for _ in range(frames):
+        for index, runner in enumerate(runners):
+            start = time.perf_counter()
+            last[index] = runner.frame()
+            seconds[index].append(time.perf_counter() - start)
+    return seconds, last
+
+
+def run_bench(
+    surfaces: Mapping[str, Surface],
+    out_dir: Path,
+    *,
+    size: int = 1024,
+    methods: Sequence[str] = DEFAULT_METHODS,
+    frames: int = 3,
+    backend: str = "gl",
+    configs: Sequence[str] = CONFIG_NAMES,
+    equal_step: float = EQUAL_STEP,
+    exr: bool = False,
+    progress: TextIO | None = sys.stderr,
+) -> BenchRun:
+    """Measure every configuration x surface x method and write the outputs to `out_dir`.
+
+    `surfaces` maps a short key (file stem, e.g. "cross-cap") to the loaded surface.
+    """
+    from .figure import tile_image
+    from .render.image_io import write_render
+
+    _check_args(surfaces, size, methods, frames, backend, equal_step)
+    bench_configs = make_configs(configs, equal_step)
+    out_dir = Path(out_dir)
+    renders = out_dir / "renders"
+    renders.mkdir(parents=True, exist_ok=True)
+    run = BenchRun(size, frames, backend, list(methods), bench_configs, dict(surfaces),
+                   machine_info(backend))
+    say = _printer(progress)
+    say(f"bench: {len(surfaces)} surface(s), {size}x{size}, {frames} frame(s) after 1 warm-up, "
+        f"backend {backend} ({run.machine.get('gl_renderer', '?')})")
+
+    references: dict[str, RenderResult] = {}
+    for key, surface in surfaces.items():
+        start = time.perf_counter()
+        unused = METHODS["taylor"].defaults  # the reference has no method constants
+        ref = open_runner(surface, "reference", "", unused, size, size).frame()
+        run.reference_seconds[key] = time.perf_counter() - start
+        references[key] = ref
+        name = f"{key}-reference.png"
+        write_render(ref, renders / name, metadata(surface, "reference", "", unused, ref))
+        run.tiles["reference", key, "reference"] = tile_image(ref.color, TILE)
+        say(f"reference {key}: {run.reference_seconds[key]:.2f} s")
+
+    total = sum(len(surfaces) * len(c.applies_to(methods)) for c in bench_configs)
+    done = 0
+    for config in bench_configs:
+        say(f"{config.name}: {config.title}")
+        chosen = config.applies_to(methods)
+        for key, surface in surfaces.items():
+            constants = [METHODS[m].constants(**config.overrides) for m in chosen]
+            runners, setup = [], []
+            try:
+                for method, method_constants in zip(chosen, constants, strict=True):
+                    start = time.perf_counter()
+                    runners.append(
+                        open_runner(surface, backend, method, method_constants, size, size))
+                    setup.append(time.perf_counter() - start)
+                seconds, results = time_interleaved(runners, frames)
+            finally:
+                for runner in runners:
+                    runner.release()
+            for index, method in enumerate(chosen):
+                done += 1
+                result = results[index]
+                fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
+                stem = f"{key}-{method}-{config.name}"
+                meta = metadata(surface, backend, method, constants[index], result)
+                write_render(result, renders / f"{stem}.png", meta)
+                if exr:
+                    write_render(result, renders / f"{stem}.exr", meta)
+                run.cells[config.name, key, method] = Cell(
+                    fps, seconds[index], setup[index], compare(result, references[key]),
+                    f"renders/{stem}.png")
+                run.tiles[config.name, key, method] = tile_image(result.color, TILE)
+                say(f"[{done:>{len(str(total))}}/{total}] {key} {method} {config.name}: "
+                    f"{fps:.3g} fps")
+            del results
+    run.machine["load_average_end"] = _load_average()
+    _fill_ratios(run)
+    write_outputs(run, out_dir)
+    say(f"wrote {out_dir / 'table.md'}, table.json, figure.png, renders/")
+    return run
+
+
+def _check_args(surfaces, size, methods, frames, backend, equal_step) -> None:
+    if not surfaces:
+        raise InputError("give at least one surface")
+    if not 8 <= size <= 8192:
+        raise InputError(f"--size must be between 8 and 8192 pixels (got {size})")
+    if not 1 <= frames <= 1000:
+        raise InputError(f"--frames must be between 1 and 1000 (got {frames})")
+    if not methods:
+        raise InputError("give at least one method")
+    for method in methods:
+        if method not in METHODS:
+            raise InputError(f"unknown method '{method}'; choose from {', '.join(METHODS)}")
+    if len(set(methods)) != len(methods):
+        raise InputError("a method is listed twice in --methods")
+    if backend == "reference" or backend not in BACKENDS:
+        choices = ", ".join(b for b in BACKENDS if b != "reference")
+        raise InputError(f"bench needs a GPU backend ({choices}), got '{backend}'")
+    if not 0.0 < equal_step < 1e6:
+        raise InputError(f"--equal-step must be a positive number (got {equal_step})")
+
+
+def _fill_ratios(run: BenchRun) -> None:
+    """fps / taylor's fps measured in the baseline configuration of the same run."""
+    for (config_name, key, _method), cell in run.cells.items():
+        config = next(c for c in run.configs if c.name == config_name)
+        base = run.cells.get((config.baseline or config.name, key, "taylor"))
+        cell.ratio_to_taylor = cell.fps / base.fps if base is not None else None
+
+
+def _printer(stream: TextIO | None):
+    def say(line: str) -> None:
+        if stream is not None:
+            print(line, file=stream, flush=True)
+
+    return say
+
+
+# ---- outputs ----------------------------------------------------------------------------
+
+
+def write_outputs(run: BenchRun, out_dir: Path) -> list[Path]:
+    """table.md, table.json and the figures, each written atomically."""
+    out_dir = Path(out_dir)
+    paths = [out_dir / "table.md", out_dir / "table.json"]
+    write_atomic(paths[0], format_markdown(run))
+    write_atomic(paths[1], json.dumps(run.as_json(), indent=2) + "\n")
+    for index, config in enumerate(run.configs):
+        path = out_dir / ("figure.png" if index == 0 else f"figure-{config.name}.png")
+        figure = build_figure(run, config)
+        write_with(path, lambda tmp, image=figure: image.save(tmp, format="PNG"))
+        paths.append(path)
+    return paths
+
+
+def build_figure(run: BenchRun, config: BenchConfig):
+    """Rows = surfaces, columns = the configuration's methods + the reference (Fig. 2)."""
+    from .figure import grid_figure
+
+    methods = run.config_methods(config)
+    columns = [*methods, "reference"]
+    tiles, captions = {}, {}
+    for key in run.surfaces:
+        for method in methods:
+            cell = run.cells.get((config.name, key, method))
+            if cell is None:
+                continue
+            tiles[key, method] = run.tiles[config.name, key, method]
+            captions[key, method] = (
+                method, f"SSIM {cell.metrics['ssim']:.4f}",
+                f"false {cell.metrics['false_hits']} missed {cell.metrics['missed_hits']} "
+                f"wrong {cell.metrics['wrong_root']}")
+        tiles[key, "reference"] = run.tiles["reference", key, "reference"]
+        captions[key, "reference"] = ("exact reference", "(float64 roots)", "")
+    title = f"implc bench {config.name}: {config.title}; {run.size}x{run.size}"
+    return grid_figure(list(run.surfaces), columns, tiles, captions, title)
+
+
+def _cell_text(cell: Cell | None) -> str:
+    if cell is None:
+        return "–"
+    m = cell.metrics
+    ratio = "–" if cell.ratio_to_taylor is None else f"{cell.ratio_to_taylor:.2f}"
+    return (f"{cell.fps:.3g} ({ratio}) / {100 * m['ssim']:.2f}% / {m['false_hits']} / "
+            f"{m['missed_hits']} / {m['wrong_root']} / {m['mean_steps']:.1f}")
+
+
+def format_markdown(run: BenchRun) -> str:
+    """One table per configuration (rows = surfaces, columns = methods), then the paper."""
+    machine = run.machine
+    lines = [
+        "# implc bench",
+        "",
+        f"{run.size}x{run.size} pixels, backend `{run.backend}` "
+        f"(GL renderer: {machine.get('gl_renderer', 'n/a')}), CPU: {machine['cpu_model']} "
+        f"({machine['cpu_count']} logical CPUs). Speed: median fps over {run.frames} frame(s) "
+        "after 1 warm-up frame, each ended by readback; the methods of a surface take "
+        "their frames in turns. Load average (1, 5, 15 min) at start "
+        f"{machine.get('load_average_start')}, at end {machine.get('load_average_end')} "
+        "(other work on the machine lowers fps).",
+        "",
+        "Cell: `fps (fps ratio to taylor) / SSIM / false hits / missed hits / wrong-root "
+        f"pixels / mean march steps per pixel`, against the exact CPU reference "
+        f"(wrong root: both hit and |t - t_ref| > {T_TOL:g}).",
+        "",
+        "Exact reference (CPU, float64): "
+        + ", ".join(f"{k} {s:.2f} s" for k, s in run.reference_seconds.items()) + ".",
+        "",
+    ]
+    for config in run.configs:
+        methods = run.config_methods(config)
+        baseline = config.baseline or config.name
+        lines += [f"## {config.name}: {config.title}", ""]
+        if baseline != config.name:
+            lines += [f"fps ratio against taylor in `{baseline}`.", ""]
+        lines += ["| surface | " + " | ".join(methods) + " |",
+                  "|---|" + "---|" * len(methods)]
+        for key in run.surfaces:
+            cells = [_cell_text(run.cells.get((config.name, key, m))) for m in methods]
+            lines.append(f"| {key} | " + " | ".join(cells) + " |")
+        lines.append("")
+    lines += _paper_comparison(run)
+    return "\n".join(lines)
+
+
+def _paper_comparison(run: BenchRun) -> list[str]:
+    """Paper Table 1 beside the `paper` configuration: fps ratio to taylor and SSIM."""
+    if not any(c.name == "paper" for c in run.configs):
+        return []
+    keys = [k for k in run.surfaces if k in PAPER_TABLE1]
+    methods = [m for m in PAPER_TABLE1["cross-cap"] if m in run.methods]
+    if not keys or not methods:
+        return []
+    lines = [
+        "## paper Table 1 beside `paper`",
+        "",
+        "Cell: fps ratio to taylor (SSIM), the paper's and ours. The paper's "
+        "hessian column is its own ground truth, so it has no SSIM.",
+        "",
+        "| surface | " + " | ".join(methods) + " |",
+        "|---|" + "---|" * len(methods),
+    ]
+    for key in keys:
+        row = PAPER_TABLE1[key]
+        cells = []
+        for m in methods:
+            fps, ssim = row[m]
+            paper = f"{fps / row['taylor'][0]:.3f}" + (f" ({100 * ssim:.2f}%)" if ssim else "")
+            cell = run.cells.get(("paper", key, m))
+            ours = "–" if cell is None or cell.ratio_to_taylor is None else (
+                f"{cell.ratio_to_taylor:.3f} ({100 * cell.metrics['ssim']:.2f}%)")
+            cells.append(f"paper {paper}; ours {ours}")
+        lines.append(f"| {key} | " + " | ".join(cells) + " |")
+    lines.append("")
+    return lines

@@ -1,0 +1,328 @@
+"""The `implc` command: argument parsing and exit codes only; the work is in the library.
+
+Exit codes: 0 ok, 1 bad input (equation, surface file, parameter), 2 bad command line,
+3 a shader failed validation, 4 a tool or runtime is missing or failed, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from . import __version__
+from .backends import TARGETS
+from .errors import EXIT_INTERRUPTED, EXIT_OK, ImplcError, InputError, ValidationError
+from .fileio import write_atomic
+from .methods import METHODS, TAYLOR2_CHOICES, Constants
+from .render.run import BACKENDS
+
+EPILOG = """\
+surfaces: a TOML file, a bundled example name (see `implc list`), or -e "EQUATION".
+
+examples:
+  implc list
+  implc show cross-cap
+  implc compile cross-cap -t glsl -m hessian -o cross-cap.frag --validate
+  implc compile -e "x^2 + y^2 + z^2 = 1" -m taylor --flavor shadertoy
+  implc compile cross-cap --emit library --prefix cc_ -o cc.glsl
+  implc validate cross-cap.frag
+  implc render cross-cap -m hessian --size 512 -o cross-cap.png
+  implc compare cc-hessian.exr cc-reference.exr
+  implc bench cross-cap miter steiner --size 512 -o results/
+
+exit codes: 0 ok, 1 bad input, 2 bad command line, 3 validation failed,
+            4 tool or runtime missing, 130 interrupted
+"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return EXIT_OK
+    try:
+        return args.run(args)
+    except ImplcError as err:
+        print(err.render(), file=sys.stderr)
+        return err.exit_code
+    except KeyboardInterrupt:
+        print("implc: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except RecursionError:
+        print("implc: error: too complex: expression nesting exceeds Python's limits",
+              file=sys.stderr)
+        return 1
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="implc",
+        description="Compile implicit-surface equations into robust GPU ray-marching shaders.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"implc {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = sub.add_parser("list", help="list the bundled example surfaces")
+    p.set_defaults(run=cmd_list)
+
+    p = sub.add_parser("show", help="print the equation, degree, derivatives and op counts")
+    _surface_args(p)
+    p.add_argument("-m", "--method", choices=sorted(METHODS), default="hessian",
+                   help="method whose shader functions to count (default: hessian)")
+    p.set_defaults(run=cmd_show)
+
+    p = sub.add_parser("compile", help="emit a shader for a surface",
+                       formatter_class=argparse.RawDescriptionHelpFormatter,
+                       description="Emit a complete shader program or a drop-in library.")
+    _surface_args(p)
+    _shader_args(p)
+    p.add_argument("--emit", choices=("program", "library"), default="program",
+                   help="program: a complete shader; library: the functions only")
+    p.add_argument("--prefix", default="",
+                   help="prefix for every global name (library drop-ins), e.g. cc_")
+    p.add_argument("-o", "--output", type=Path, help="output file (default: stdout)")
+    p.add_argument("--validate", action="store_true",
+                   help="validate with the language's real compiler before writing")
+    p.set_defaults(run=cmd_compile)
+
+    p = sub.add_parser("validate", help="check shader files with their real compilers")
+    p.add_argument("files", nargs="+", type=Path, metavar="FILE")
+    p.set_defaults(run=cmd_validate)
+
+    p = sub.add_parser("render", help="render a surface to PNG or EXR (+ JSON sidecar)")
+    _surface_args(p)
+    _shader_args(p)
+    p.add_argument("-b", "--backend", choices=list(BACKENDS), default="gl",
+                   help="gl: GLSL on OpenGL (llvmpipe here); reference: exact CPU float64; "
+                        "see README for the others")
+    p.add_argument("--size", type=int, help="square image size in pixels (default 512)")
+    p.add_argument("--width", type=int)
+    p.add_argument("--height", type=int)
+    p.add_argument("-o", "--output", type=Path, required=True,
+                   help="out.png (for people) or out.exr (R G B A Z steps); out.json beside it")
+    p.set_defaults(run=cmd_render)
+
+    p = sub.add_parser("compare", help="metrics of one EXR render against another",
+                       description="SSIM, false/missed hits, wrong-root pixels and steps of "
+                                   "render A against render B (typically the reference).")
+    p.add_argument("a", type=Path, metavar="A", help="render to judge (EXR + JSON sidecar)")
+    p.add_argument("b", type=Path, metavar="B", help="render to judge it by, e.g. the reference")
+    p.add_argument("--t-tol", type=float, default=None,
+                   help="wrong-root tolerance on t, scene units (default 1e-3)")
+    p.add_argument("--json", action="store_true", help="print the metrics as JSON")
+    p.set_defaults(run=cmd_compare)
+
+    p = sub.add_parser("bench", help="the paper's Table 1: fps and accuracy of every method",
+                       description="Time every method on each surface and compare it with "
+                                   "the exact reference; writes table.md, table.json, "
+                                   "figure.png and renders/ into -o DIR.")
+    p.add_argument("surfaces", nargs="+", metavar="SURFACE",
+                   help="TOML files or bundled example names (e.g. cross-cap miter steiner)")
+    p.add_argument("--size", type=int, default=1024,
+                   help="square image size in pixels (default 1024, the paper's)")
+    p.add_argument("--methods", nargs="+", choices=list(METHODS), metavar="METHOD",
+                   help="methods to time (default: taylor curvature hessian-approx hessian sign)")
+    p.add_argument("--frames", type=int, default=3,
+                   help="timed frames per cell after 1 warm-up; fps is their median (default 3)")
+    p.add_argument("-b", "--backend", choices=[b for b in BACKENDS if b != "reference"],
+                   default="gl", help="renderer to time (default gl)")
+    p.add_argument("--configs", default="paper,equal,taylor2",
+                   help="comma-separated: paper (Table 1 constants), equal (one step for "
+                        "all), taylor2 (Eq. 4 consistent); default all three")
+    p.add_argument("--equal-step", type=float, default=None,
+                   help="base step of every method in the `equal` configuration (default 0.002)")
+    p.add_argument("--exr", action="store_true",
+                   help="also write each render as EXR (for `implc compare`; 24 MB at 1024²)")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
+                   help="output directory (created if missing)")
+    p.set_defaults(run=cmd_bench)
+    return parser
+
+
+def _surface_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("surface", nargs="?", help="TOML file or bundled example name")
+    p.add_argument("-e", "--equation", help='equation text instead of a file, e.g. "x^2+y^2+z^2=1"')
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="set a named parameter (repeatable)")
+    limits = p.add_argument_group("limits (hostile-input guards)")
+    limits.add_argument("--max-degree", type=int, help="largest total degree (default 40)")
+    limits.add_argument("--max-exponent", type=int, help="largest integer exponent (default 64)")
+    limits.add_argument("--max-nodes", type=int, help="largest expression size (default 10000)")
+
+
+def _shader_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("-t", "--target", choices=list(TARGETS), default="glsl",
+                   help="shader language (default: glsl)")
+    p.add_argument("-m", "--method", choices=list(METHODS), default="hessian",
+                   help="root-finding method (default: hessian); see README")
+    p.add_argument("--flavor", help="glsl: 330 (default), 450, es300, shadertoy")
+    p.add_argument("--precision", choices=("float", "double"),
+                   help="opencl: float (default) or double (needs an fp64 device)")
+    d = Constants()
+    c = p.add_argument_group("method constants (defaults: the paper's Table 1)")
+    c.add_argument("--step", type=float, help="base step b (default 0.01; hessian 0.002)")
+    c.add_argument("--tau1", type=float, help=f"|F| <= tau1: near the surface (default {d.tau1})")
+    c.add_argument("--tau2", type=float, help=f"|F| > tau2: far from it (default {d.tau2})")
+    c.add_argument("--tau3", type=float, help=f"|F'| <= tau3: silhouette (default {d.tau3})")
+    c.add_argument("--eps", type=float,
+                   help=f"hessian-approx finite-difference step (default {d.eps})")
+    c.add_argument("--taylor2", choices=TAYLOR2_CHOICES,
+                   help="Eq. 4 as printed (paper, default) or consistent (h^2/8, F''(t1))")
+    c.add_argument("--max-steps", type=int, help=f"march step cap per ray (default {d.max_steps})")
+
+
+def _limits(args):
+    from .parse import Limits
+
+    given = {
+        "max_degree": args.max_degree,
+        "max_exponent": args.max_exponent,
+        "max_nodes": args.max_nodes,
+    }
+    return Limits(**{k: v for k, v in given.items() if v is not None})
+
+
+def _surface(args):
+    from .surface import load_surface
+
+    return load_surface(args.surface, args.equation, args.param, _limits(args))
+
+
+def _constants(args) -> Constants:
+    method = METHODS[args.method]
+    values = {
+        "step": args.step, "tau1": args.tau1, "tau2": args.tau2, "tau3": args.tau3,
+        "eps": args.eps, "taylor2": args.taylor2, "max_steps": args.max_steps,
+    }
+    for key in ("step", "tau1", "tau2", "tau3", "eps"):
+        value = values[key]
+        if value is not None and not 0.0 < value < 1e6:
+            raise InputError(f"--{key} must be a positive number (got {value})")
+    if values["max_steps"] is not None and not 1 <= values["max_steps"] <= 10_000_000:
+        raise InputError("--max-steps must be between 1 and 10000000")
+    return method.constants(**values)
+
+
+def cmd_list(args) -> int:
+    from .derive import polynomial_degree
+    from .surface import example_paths, load_surface
+
+    for name in example_paths():
+        surface = load_surface(name)
+        degree = polynomial_degree(surface.expr)
+        kind = f"deg {degree}" if degree else "non-poly"
+        print(f"{name:<18} {kind:<9} {surface.equation}")
+    return EXIT_OK
+
+
+def cmd_show(args) -> int:
+    from .show import describe
+
+    print(describe(_surface(args), METHODS[args.method]))
+    return EXIT_OK
+
+
+def cmd_compile(args) -> int:
+    from .emit import emit
+
+    surface = _surface(args)
+    text = emit(surface, args.target, args.method, _constants(args), args.flavor, args.emit,
+                args.prefix, precision=args.precision)
+    if args.validate:
+        from .validate import validate_text
+
+        name = str(args.output) if args.output else f"<stdout>.{args.target}"
+        verdict = validate_text(text, args.target, name)
+        if not verdict.ok:
+            raise ValidationError(verdict.render(name))
+        print(verdict.render(name), file=sys.stderr)
+    if args.output:
+        write_atomic(args.output, text)
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
+
+
+def cmd_validate(args) -> int:
+    from .validate import validate_file
+
+    failed = 0
+    for path in args.files:
+        if not path.is_file():
+            print(f"implc: error: {path}: no such file", file=sys.stderr)
+            failed += 1
+            continue
+        verdict = validate_file(path)
+        print(verdict.render(str(path)), file=sys.stdout if verdict.ok else sys.stderr)
+        failed += not verdict.ok
+    return 3 if failed else EXIT_OK
+
+
+def cmd_render(args) -> int:
+    from .render.run import render_surface
+
+    width, height = _size(args)
+    backend = args.backend
+    if args.precision == "double":  # the double OpenCL program is its own backend
+        if backend not in ("cl", "cl-double"):
+            raise InputError("--precision double renders with -b cl (OpenCL) only")
+        backend = "cl-double"
+    surface = _surface(args)
+    start = time.perf_counter()
+    paths = render_surface(surface, backend, args.method, _constants(args), width, height,
+                           args.output)
+    elapsed = time.perf_counter() - start
+    for path in paths:
+        print(f"wrote {path}")
+    print(f"rendered {width}x{height} with {backend}/{args.method} in {elapsed:.2f} s",
+          file=sys.stderr)
+    return EXIT_OK
+
+
+def cmd_compare(args) -> int:
+    import json
+
+    from .compare import compare_files, format_metrics
+    from .metrics import T_TOL
+
+    t_tol = T_TOL if args.t_tol is None else args.t_tol
+    if not 0.0 < t_tol < 1e6:
+        raise InputError(f"--t-tol must be a positive number (got {t_tol})")
+    metrics = compare_files(args.a, args.b, t_tol)
+    print(json.dumps(metrics, indent=2) if args.json else format_metrics(metrics))
+    return EXIT_OK
+
+
+def cmd_bench(args) -> int:
+    from .bench import DEFAULT_METHODS, EQUAL_STEP, run_bench
+    from .surface import load_surface
+
+    surfaces = {}
+    for spec in args.surfaces:
+        key = Path(spec).stem
+        if key in surfaces:
+            raise InputError(f"surface '{key}' is given twice")
+        surfaces[key] = load_surface(spec)
+    configs = [name.strip() for name in args.configs.split(",") if name.strip()]
+    run_bench(
+        surfaces, args.output, size=args.size, methods=args.methods or DEFAULT_METHODS,
+        frames=args.frames, backend=args.backend, configs=configs,
+        equal_step=EQUAL_STEP if args.equal_step is None else args.equal_step, exr=args.exr,
+    )
+    return EXIT_OK
+
+
+def _size(args) -> tuple[int, int]:
+    if args.size is not None and (args.width or args.height):
+        raise InputError("give --size or --width/--height, not both")
+    width = args.width or args.size or 512
+    height = args.height or args.size or 512
+    for value in (width, height):
+        if not 1 <= value <= 8192:
+            raise InputError(f"image size must be between 1 and 8192 pixels (got {value})")
+    return width, height

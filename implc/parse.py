@@ -1,0 +1,1157 @@
+"""Equation text -> sympy expression, safely.
+
+This module is the only place that reads user-written equations. It never hands user text
+to `eval`, `exec`, `sympify`, `parse_expr` or `Rational(str)`: a hand-written tokenizer and
+Pratt parser build a small AST, every limit is checked on that AST, and only then are
+sympy nodes built directly (`Add`, `Mul`, `Pow`, `Rational(p, q)`, and the constructors in
+`functions.USER_FUNCTIONS`). Every problem is an `InputError` (a `LimitError` for input
+that is well formed but too large) located at the offending span; no other exception
+escapes for any input string.
+
+The language (DESIGN.md section 3):
+
+- numbers `2`, `0.5`, `.5`, `1e-3`, `2E+4`, read exactly (`0.1` is 1/10). A number followed
+  by `e` and digits is scientific notation (`2e-3` is 0.002); otherwise `e` is the
+  constant (`2e` is 2*e, `2e+x` is 2*e + x);
+- variables `x y z`; constants `pi`, `e`; named parameters (substituted by their values);
+  function calls `name(arg, ...)` from the function table, with its arity;
+- `+ - * /`; powers `^` and `**`, right-associative and binding tighter than a unary
+  sign (`-x^2` is `-(x^2)`, `2^3^2` is 512, `2^-1` is 1/2); `(...)` and `[...]`;
+- implicit multiplication, binding like `*`: `4x^2(x+1)`, `x^2y^2`, `(x+1)(x-1)`,
+  `2 x y`, `a(x+1)` for a parameter or constant `a` (a function name followed by `(` is a
+  call). A word that is not a declared name and is made only of the letters x, y, z is a
+  product of those variables (`xyz`, `xy^2` = x*y^2). A number needs an explicit operator
+  before it (`x 2` is an error, `2x` is not);
+- `lhs = rhs` gives `lhs - rhs`; a bare expression means `= 0`. The equation must
+  depend on x, y or z.
+
+Semantics:
+
+- `b^(p/q)` with a non-integer rational exponent and odd q (`x^(1/3)`, `x^(2/3)`) is the
+  real root, defined for negative b on every target: `sign(b) * |b|^(p/q)` for odd p,
+  `|b|^(p/q)` for even p. Other non-integer exponents (`x^0.5`, `x^pi`) are an ordinary
+  power, defined for b >= 0 only (like `pow` in GLSL). A negative rational base needs an
+  integer exponent or a fraction with an odd denominator.
+- Exponents of expressions that depend on x, y, z must be constant; a constant base may
+  have a variable exponent (`2^x`, `e^(-x^2)`).
+- Division by a constant zero is an error, and so is a constant sub-expression that sympy
+  evaluates to a non-real, infinite or undefined value (`sqrt(-1)`, `log(0)`).
+- `min` and `max` are built unevaluated: sympy compares every pair of (flattened)
+  arguments symbolically when it evaluates them, which takes minutes for nested calls.
+
+Limits (`Limits`, each a command-line option named after its field) are checked on the
+AST before sympy builds anything: input length first, on the raw string; then nesting
+depth and node count while parsing; then, bottom-up, literal magnitude, integer exponent
+size, size of exactly computed constants (`9^9^9` is refused, never computed), estimated
+polynomial degree and estimated number of monomials after expansion.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from fractions import Fraction
+from functools import lru_cache
+
+import sympy
+
+from implc.errors import InputError, LimitError, Source
+from implc.functions import CONSTANTS, USER_FUNCTIONS
+from implc.symbols import X, Y, Z
+
+__all__ = ["Limits", "check_param_name", "parse_equation", "parse_number"]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Bounds that keep parsing and every later stage fast; each has a `--max-...` option."""
+
+    # Input length in characters, checked first, on the raw string.
+    max_chars: int = 20_000
+    # Nesting of brackets and operators (parser recursion depth).
+    max_depth: int = 200
+    # AST nodes, and the estimated size of the sympy tree built from them.
+    max_nodes: int = 10_000
+    # |exponent| of a power whose base is not a rational number (x^n, sin(x)^n, pi^n).
+    max_exponent: int = 64
+    # Estimated total degree in x, y, z after expansion (non-polynomial parts count 1).
+    max_degree: int = 40
+    # Estimated number of monomials after full expansion.
+    max_terms: int = 200_000
+    # Decimal exponent bound of number literals: 10^-N <= |literal| <= 10^N unless zero.
+    # float32 shaders cannot represent values far outside this range meaningfully.
+    max_literal_exponent: int = 30
+    # Decimal digits of the numerator or denominator of any rational constant computed
+    # exactly while parsing (literals, folded constants such as 2^100 or 9^9^9).
+    max_constant_digits: int = 300
+
+
+_WHITESPACE = " \t\n\r"
+_OPERATORS = ("**", "==", "+", "-", "*", "/", "^", "=", "(", ")", "[", "]", ",")
+_NUMBER_RE = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_NUMBER_PARTS_RE = re.compile(r"(\d*)(?:\.(\d*))?(?:[eE]([+-]?\d+))?")
+_MALFORMED_NUMBER_RE = re.compile(r"[0-9.]*")
+_WORD_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+_VARIABLES: dict[str, sympy.Symbol] = {"x": X, "y": Y, "z": Z}
+_CLOSING = {"(": ")", "[": "]"}
+
+# Binding powers (left, right) of the infix operators; right < left is right-associative.
+_INFIX_BP: dict[str, tuple[int, int]] = {
+    "+": (10, 11),
+    "-": (10, 11),
+    "*": (20, 21),
+    "/": (20, 21),
+    "^": (31, 30),
+    "**": (31, 30),
+}
+_IMPLICIT_BP = (20, 21)  # implicit multiplication binds like `*`
+_PREFIX_BP = 25  # unary sign: tighter than `*`, looser than `^`
+
+# Characters people paste from papers and word processors, and what they meant.
+_LOOKALIKES: dict[str, str] = {
+    "\u2212": "-",  # minus sign
+    "\u2010": "-",  # hyphen
+    "\u2013": "-",  # en dash
+    "\u2014": "-",  # em dash
+    "\u00d7": "*",  # multiplication sign
+    "\u00b7": "*",  # middle dot
+    "\u22c5": "*",  # dot operator
+    "\u2217": "*",  # asterisk operator
+    "\u00f7": "/",  # division sign
+    "\u2215": "/",  # division slash
+    "\u2044": "/",  # fraction slash
+    "\u00b2": "^2",
+    "\u00b3": "^3",
+    "\u00b9": "^1",
+    "\u2070": "^0",
+    "\u2074": "^4",
+    "\u2075": "^5",
+    "\u2076": "^6",
+    "\u2077": "^7",
+    "\u2078": "^8",
+    "\u2079": "^9",
+    "\u03c0": "pi",
+    "\uff08": "(",
+    "\uff09": ")",
+    "\uff1d": "=",
+}
+
+# Names from other languages, with the hint to give when they are called.
+_FUNCTION_ALIASES: dict[str, str] = {
+    "ln": "log",
+    "arcsin": "asin",
+    "arccos": "acos",
+    "arctan": "atan",
+    "arctan2": "atan2",
+    "sgn": "sign",
+    "fabs": "abs",
+    "fmin": "min",
+    "fmax": "max",
+    "sh": "sinh",
+    "ch": "cosh",
+    "th": "tanh",
+}
+_POWER_FUNCTIONS = ("pow", "power", "powf")
+
+# sympy classes that compare all their arguments pairwise when evaluated (see docstring).
+_UNEVALUATED = frozenset({"Min", "Max"})
+
+_LOG10_2 = 30103  # log10(2) * 10^5, for exact integer comparisons of digit counts
+_NON_REAL_MESSAGES: tuple[tuple[sympy.Basic, str], ...] = (
+    (sympy.nan, "value is undefined"),
+    (sympy.zoo, "value is infinite"),
+    (sympy.oo, "value is infinite"),
+    (-sympy.oo, "value is infinite"),
+    (sympy.I, "value is not a real number"),
+)
+
+
+# --------------------------------------------------------------------------- public API
+
+
+def parse_equation(
+    source: Source,
+    params: Mapping[str, sympy.Expr] | None = None,
+    limits: Limits = Limits(),  # noqa: B008 - frozen, so a shared default is safe
+) -> sympy.Expr:
+    """Parse `source.text` into the sympy expression `lhs - rhs`, parameters substituted.
+
+    Raises `InputError` (or `LimitError`) located in `source`; nothing else for any text.
+    `params` maps parameter names to their (rational) values; names are checked with
+    `check_param_name`.
+    """
+    text = source.text
+    if len(text) > limits.max_chars:
+        raise LimitError(
+            f"too complex: input length {len(text)} exceeds the limit of "
+            f"{limits.max_chars} characters (--max-chars)",
+            source,
+            limits.max_chars,
+            1,
+        )
+    if not text.strip(_WHITESPACE):
+        raise InputError("empty equation", source, 0, 1)
+    values = _param_values(params or {})
+    try:
+        tokens = _tokenize(text, values)
+        root = _Parser(source, tokens, values, limits).parse()
+        info = _Analyzer(source, values, limits).analyze(root)
+        return _Builder(source, values, info).build(root)
+    except RecursionError:
+        raise LimitError(
+            f"too complex: nesting depth exceeds what can be parsed with the limit of "
+            f"{limits.max_depth} (--max-depth)",
+            source,
+            0,
+            1,
+        ) from None
+
+
+def parse_number(
+    text: str,
+    source: Source | None = None,
+    limits: Limits = Limits(),  # noqa: B008 - frozen, so a shared default is safe
+) -> sympy.Rational:
+    """Read a parameter value (`--param a=0.5`, a TOML value) exactly.
+
+    Accepts an optional sign, a number literal as in equations, and an optional
+    `/ denominator` (`1/3`). Rejects nan, inf and anything else with `InputError`.
+    Error offsets index `text`: pass a `source` whose text is `text`.
+    """
+    stripped = text.strip(_WHITESPACE)
+    lead = len(text) - len(text.lstrip(_WHITESPACE))
+    if not stripped:
+        raise InputError("empty number", source, 0, max(1, len(text)))
+    match = re.fullmatch(
+        r"([+-]?)(" + _NUMBER_RE.pattern + r")(?:[ \t]*/[ \t]*([+-]?)("
+        + _NUMBER_RE.pattern + r"))?",
+        stripped,
+    )
+    if match is None:
+        if stripped.lstrip("+-").lower() in ("nan", "inf", "infinity"):
+            message = f"number must be finite, got {_quote(stripped)}"
+        else:
+            message = f"invalid number {_quote(stripped)}"
+        raise InputError(message, source, lead, len(stripped))
+    numerator = _literal_value(match.group(2), source, lead + match.start(2), limits)
+    if match.group(1) == "-":
+        numerator = -numerator
+    value = numerator
+    if match.group(4) is not None:
+        start = lead + match.start(4)
+        denominator = _literal_value(match.group(4), source, start, limits)
+        if match.group(3) == "-":
+            denominator = -denominator
+        if denominator == 0:
+            raise InputError("division by zero", source, start, len(match.group(4)))
+        value = numerator / denominator
+        if _too_many_digits(value, limits.max_constant_digits):
+            raise _constant_digits_error("number", limits, source, lead, len(stripped))
+    return sympy.Rational(value.numerator, value.denominator)
+
+
+def check_param_name(name: str, source: Source | None = None) -> None:
+    """Raise `InputError` unless `name` can be a parameter of an equation.
+
+    A parameter must be an identifier that does not shadow x, y, z, a function or a
+    constant, and is not made only of x, y, z (it would read as a product). The error
+    spans `name` from offset 0 of `source`.
+    """
+    length = max(1, len(name))
+    if not name:
+        raise InputError("empty parameter name", source, 0, 1)
+    if not _IDENTIFIER_RE.match(name):
+        raise InputError(f"parameter name {_quote(name)} is not an identifier", source, 0, length)
+    if name in _VARIABLES:
+        raise InputError(f"parameter name '{name}' shadows the variable {name}", source, 0, 1)
+    if set(name) <= set(_VARIABLES):
+        raise InputError(
+            f"parameter name '{name}' would read as a product of x, y, z", source, 0, length
+        )
+    if name in USER_FUNCTIONS:
+        raise InputError(
+            f"parameter name '{name}' shadows the function {name}", source, 0, length
+        )
+    if name in CONSTANTS:
+        raise InputError(
+            f"parameter name '{name}' shadows the constant {name}", source, 0, length
+        )
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _quote(text: str, width: int = 24) -> str:
+    """`'text'` for a message, shortened so a huge token cannot flood the terminal."""
+    if len(text) > width:
+        text = text[: width - 3] + "..."
+    return f"'{text}'"
+
+
+def _show(value: Fraction) -> str:
+    """A rational for a message: exact when short, its order of magnitude otherwise."""
+    text = str(value)
+    if len(text) <= 20:
+        return text
+    magnitude = abs(value)
+    exponent = magnitude.numerator.bit_length() - magnitude.denominator.bit_length()
+    return f"{'-' if value < 0 else ''}about 2^{exponent}"
+
+
+def _too_many_digits(value: Fraction, max_digits: int) -> bool:
+    """True when the numerator or denominator of `value` has more than `max_digits` digits."""
+    bits = max(abs(value.numerator).bit_length(), value.denominator.bit_length())
+    return (bits - 1) * _LOG10_2 > max_digits * 100_000
+
+
+def _constant_digits_error(
+    what: str, limits: Limits, source: Source | None, start: int, length: int
+) -> LimitError:
+    return LimitError(
+        f"too complex: {what} exceeds the limit of {limits.max_constant_digits} digits "
+        f"(--max-constant-digits)",
+        source,
+        start,
+        length,
+    )
+
+
+def _literal_value(text: str, source: Source | None, start: int, limits: Limits) -> Fraction:
+    """The exact value of a number literal, range-checked before any big integer is made."""
+    match = _NUMBER_PARTS_RE.fullmatch(text)
+    assert match is not None  # the tokenizer only produces well-formed literals
+    int_part, frac_part = match.group(1), match.group(2) or ""
+    exp_text = match.group(3) or "0"
+    digits = (int_part + frac_part).lstrip("0")
+    if not digits:
+        return Fraction(0)
+    significant = digits.rstrip("0")
+    bound = limits.max_literal_exponent
+    # |exponent| >= 10^9 is far outside any range: clamp it rather than build a huge int.
+    exp_digits = exp_text.lstrip("+-").lstrip("0") or "0"
+    if len(exp_digits) <= 9:
+        exponent = int(exp_text)
+    else:
+        exponent = -(10**10) if exp_text.startswith("-") else 10**10
+    # value = significant * 10^scale; top = floor(log10(value))
+    scale = exponent - len(frac_part) + len(digits) - len(significant)
+    top = len(significant) - 1 + scale
+    if top > bound or (top == bound and significant != "1"):
+        raise LimitError(
+            f"too complex: number {_quote(text)} exceeds the limit of 1e{bound} "
+            f"(--max-literal-exponent)",
+            source,
+            start,
+            len(text),
+        )
+    if top < -bound:
+        raise LimitError(
+            f"too complex: nonzero number {_quote(text)} is below the limit of 1e-{bound} "
+            f"(--max-literal-exponent)",
+            source,
+            start,
+            len(text),
+        )
+    if len(significant) > limits.max_constant_digits:
+        raise _constant_digits_error(
+            f"number {_quote(text)}", limits, source, start, len(text)
+        )
+    if scale >= 0:
+        return Fraction(int(significant) * 10**scale)
+    return Fraction(int(significant), 10**-scale)
+
+
+def _param_values(params: Mapping[str, sympy.Expr]) -> dict[str, tuple[sympy.Expr, Fraction | None]]:
+    """Check parameter names; keep each value with its exact rational form when it has one."""
+    values: dict[str, tuple[sympy.Expr, Fraction | None]] = {}
+    for name, value in params.items():
+        check_param_name(name)
+        if isinstance(value, (int, Fraction)):
+            value = sympy.Rational(value.numerator, value.denominator)
+        if not isinstance(value, sympy.Expr) or not value.is_number:
+            raise TypeError(f"parameter {name!r} must be a sympy number, got {value!r}")
+        exact = Fraction(int(value.p), int(value.q)) if isinstance(value, sympy.Rational) else None
+        values[name] = (value, exact)
+    return values
+
+
+# --------------------------------------------------------------------------- tokens
+
+
+@dataclass(frozen=True)
+class _Token:
+    """One token; `bad` tokens carry the error to report when the parser reaches them."""
+
+    kind: str  # "num", "name", "var", "op", "bad", "end"
+    text: str
+    start: int
+    end: int
+    message: str = ""
+
+    def is_op(self, *texts: str) -> bool:
+        return self.kind == "op" and self.text in texts
+
+
+def _tokenize(text: str, params: Mapping[str, object]) -> list[_Token]:
+    """Split `text` into tokens, ending with an `end` token.
+
+    Scanning stops at the first unusable character, which becomes a `bad` token: the
+    parser reports errors in reading order, so nothing after it can matter.
+    """
+    tokens: list[_Token] = []
+    pos = 0
+    while pos < len(text):
+        ch = text[pos]
+        if ch in _WHITESPACE:
+            pos += 1
+            continue
+        if ch.isdigit() and ch.isascii() or (ch == "." and text[pos + 1 : pos + 2].isdigit()):
+            match = _NUMBER_RE.match(text, pos)
+            assert match is not None
+            end = match.end()
+            if text[end : end + 1] == ".":
+                end = _MALFORMED_NUMBER_RE.match(text, end).end()
+                literal = text[pos:end]
+                tokens.append(_Token("bad", literal, pos, end, f"malformed number {_quote(literal)}"))
+                break
+            tokens.append(_Token("num", text[pos:end], pos, end))
+            pos = end
+            continue
+        word = _WORD_RE.match(text, pos)
+        if word is not None:
+            name = word.group()
+            if name not in params and name not in CONSTANTS and name not in USER_FUNCTIONS and (
+                set(name) <= set(_VARIABLES)
+            ):
+                # `xyz` is x*y*z: one variable token per letter, each with its own column
+                tokens.extend(_Token("var", letter, pos + i, pos + i + 1) for i, letter in enumerate(name))
+            else:
+                tokens.append(_Token("name", name, pos, word.end()))
+            pos = word.end()
+            continue
+        operator = next((op for op in _OPERATORS if text.startswith(op, pos)), None)
+        if operator == "==":
+            tokens.append(_Token("bad", "==", pos, pos + 2, "use a single '=' (not '==')"))
+            break
+        if operator is not None:
+            tokens.append(_Token("op", operator, pos, pos + len(operator)))
+            pos += len(operator)
+            continue
+        tokens.append(_Token("bad", ch, pos, pos + 1, _bad_character_message(ch)))
+        break
+    tokens.append(_Token("end", "", len(text), len(text)))
+    return tokens
+
+
+def _bad_character_message(ch: str) -> str:
+    code = f"U+{ord(ch):04X}"
+    if ch.isascii():
+        if not ch.isprintable():
+            return f"unexpected control character {code}"
+        shown = f'"{ch}"' if ch == "'" else f"'{ch}'"
+        return f"unexpected character {shown}"
+    if not ch.isprintable() or ch.isspace():
+        hint = "; use a plain space" if ch.isspace() else ""
+        return f"unexpected character {code}{hint}"
+    hint = f"; did you mean '{_LOOKALIKES[ch]}'?" if ch in _LOOKALIKES else ""
+    return f"unexpected character '{ch}' ({code}){hint}"
+
+
+# --------------------------------------------------------------------------- AST
+
+
+@dataclass(eq=False)
+class _Node:
+    """An AST node covering `text[start:end]` (brackets included)."""
+
+    start: int
+    end: int
+
+
+@dataclass(eq=False)
+class _Num(_Node):
+    value: Fraction
+
+
+@dataclass(eq=False)
+class _Var(_Node):
+    name: str
+
+
+@dataclass(eq=False)
+class _Named(_Node):
+    """A constant (`pi`, `e`) or a parameter."""
+
+    name: str
+    is_param: bool
+
+
+@dataclass(eq=False)
+class _Neg(_Node):
+    operand: _Node
+
+
+@dataclass(eq=False)
+class _Sum(_Node):
+    terms: list[_Node]
+    negative: list[bool]
+
+
+@dataclass(eq=False)
+class _Product(_Node):
+    factors: list[_Node]
+    divide: list[bool]
+
+
+@dataclass(eq=False)
+class _Power(_Node):
+    base: _Node
+    exponent: _Node
+
+
+@dataclass(eq=False)
+class _Call(_Node):
+    name: str
+    args: list[_Node] = field(default_factory=list)
+
+
+def _children(node: _Node) -> list[_Node]:
+    if isinstance(node, _Sum):
+        return node.terms
+    if isinstance(node, _Product):
+        return node.factors
+    if isinstance(node, _Neg):
+        return [node.operand]
+    if isinstance(node, _Power):
+        return [node.base, node.exponent]
+    if isinstance(node, _Call):
+        return node.args
+    return []
+
+
+def _postorder(root: _Node) -> list[_Node]:
+    """Children before parents, left subtrees first; iterative, so depth cannot overflow."""
+    order: list[_Node] = []
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        order.append(node)
+        stack.extend(_children(node))
+    order.reverse()
+    return order
+
+
+# --------------------------------------------------------------------------- parser
+
+
+class _Parser:
+    """Pratt parser over the token list; one Python frame pair per nesting level."""
+
+    def __init__(
+        self,
+        source: Source,
+        tokens: list[_Token],
+        params: Mapping[str, object],
+        limits: Limits,
+    ):
+        self.source = source
+        self.tokens = tokens
+        self.params = params
+        self.limits = limits
+        self.pos = 0
+        self.prev: _Token | None = None
+        self.depth = 0
+        self.nodes = 0
+        self.seen_equals = False
+        self.contexts: list[str] = []  # "call" or "group", innermost last
+
+    # -- token access
+
+    def peek(self) -> _Token:
+        return self.tokens[self.pos]
+
+    def advance(self) -> _Token:
+        token = self.tokens[self.pos]
+        if token.kind != "end":
+            self.pos += 1
+        self.prev = token
+        return token
+
+    def error(self, message: str, start: int, end: int) -> InputError:
+        return InputError(message, self.source, start, end - start)
+
+    def error_at(self, message: str, token: _Token) -> InputError:
+        return InputError(message, self.source, token.start, max(1, token.end - token.start))
+
+    def new(self, node: _Node) -> _Node:
+        self.nodes += 1
+        if self.nodes > self.limits.max_nodes:
+            raise LimitError(
+                f"too complex: expression size exceeds the limit of {self.limits.max_nodes} "
+                f"nodes (--max-nodes)",
+                self.source,
+                node.start,
+                node.end - node.start,
+            )
+        return node
+
+    # -- grammar
+
+    def parse(self) -> _Node:
+        """equation := expression ['=' expression]; returns the node of lhs - rhs."""
+        lhs = self.expression(0)
+        token = self.peek()
+        if not token.is_op("="):
+            self.expect_end(token)
+            return lhs
+        equals = self.advance()
+        self.seen_equals = True
+        if self.peek().kind == "end":
+            raise self.error_at("missing right-hand side after '='", equals)
+        rhs = self.expression(0)
+        token = self.peek()
+        if token.is_op("="):
+            raise self.error_at("only one '=' is allowed", token)
+        self.expect_end(token)
+        return self.new(_Sum(lhs.start, rhs.end, [lhs, rhs], [False, True]))
+
+    def expect_end(self, token: _Token) -> None:
+        if token.kind == "end":
+            return
+        if token.is_op(")", "]"):
+            raise self.error_at(f"unmatched '{token.text}'", token)
+        if token.is_op(","):
+            raise self.error_at("',' is only allowed between function arguments", token)
+        raise self.error_at(f"unexpected {_quote(token.text)}", token)  # pragma: no cover
+
+    def expression(self, min_bp: int) -> _Node:
+        """Parse operators binding tighter than `min_bp` (Pratt loop)."""
+        self.depth += 1
+        if self.depth > self.limits.max_depth:
+            raise LimitError(
+                f"too complex: nesting depth exceeds the limit of {self.limits.max_depth} "
+                f"(--max-depth)",
+                self.source,
+                self.peek().start,
+                max(1, self.peek().end - self.peek().start),
+            )
+        left = self.prefix()
+        while True:
+            token = self.peek()
+            if token.kind == "op" and token.text in _INFIX_BP:
+                left_bp, right_bp = _INFIX_BP[token.text]
+                if left_bp < min_bp:
+                    break
+                self.advance()
+                right = self.expression(right_bp)
+                if token.text in ("^", "**"):
+                    left = self.new(_Power(left.start, right.end, left, right))
+                else:
+                    left = self.combine(token.text, left, right)
+            elif token.kind in ("name", "var") or token.is_op("(", "["):
+                if _IMPLICIT_BP[0] < min_bp:
+                    break
+                right = self.expression(_IMPLICIT_BP[1])
+                left = self.combine("*", left, right)
+            elif token.kind == "num":
+                raise self.error_at(f"missing operator before {_quote(token.text)}", token)
+            elif token.kind == "bad":
+                raise self.error_at(token.message, token)
+            else:  # ) ] , = end: the caller decides
+                break
+        self.depth -= 1
+        return left
+
+    def combine(self, op: str, left: _Node, right: _Node) -> _Node:
+        """Append to a left-hand sum or product (flat n-ary nodes keep the tree shallow)."""
+        if op in ("+", "-"):
+            if isinstance(left, _Sum):
+                left.terms.append(right)
+                left.negative.append(op == "-")
+                left.end = right.end
+                return left
+            return self.new(_Sum(left.start, right.end, [left, right], [False, op == "-"]))
+        if isinstance(left, _Product):
+            left.factors.append(right)
+            left.divide.append(op == "/")
+            left.end = right.end
+            return left
+        return self.new(_Product(left.start, right.end, [left, right], [False, op == "/"]))
+
+    def prefix(self) -> _Node:
+        """An operand: number, name, call, bracketed group or signed operand."""
+        token = self.peek()
+        if token.kind == "num":
+            self.advance()
+            value = _literal_value(token.text, self.source, token.start, self.limits)
+            return self.new(_Num(token.start, token.end, value))
+        if token.kind == "var":
+            self.advance()
+            return self.new(_Var(token.start, token.end, token.text))
+        if token.kind == "name":
+            self.advance()
+            return self.name(token)
+        if token.kind == "bad":
+            raise self.error_at(token.message, token)
+        if token.is_op("(", "["):
+            self.advance()
+            return self.group(token)
+        if token.is_op("-", "+"):
+            self.advance()
+            operand = self.expression(_PREFIX_BP)
+            if token.text == "+":
+                operand.start = token.start
+                return operand
+            return self.new(_Neg(token.start, operand.end, operand))
+        raise self.missing_operand(token)
+
+    def missing_operand(self, token: _Token) -> InputError:
+        """The error for `token` standing where an operand should be."""
+        prev = self.prev
+        if token.is_op("*", "/", "^", "**"):
+            return self.error_at(f"missing operand before '{token.text}'", token)
+        if token.is_op("="):
+            if self.seen_equals:
+                return self.error_at("only one '=' is allowed", token)
+            if prev is None:
+                return self.error_at("missing left-hand side before '='", token)
+        if token.is_op(","):
+            if self.contexts and self.contexts[-1] == "call":
+                return self.error_at("missing argument before ','", token)
+            return self.error_at("',' is only allowed between function arguments", token)
+        if prev is None:  # a closing bracket first
+            return self.error_at(f"unmatched '{token.text}'", token)
+        if prev.is_op("(", "["):
+            if token.is_op(")", "]"):
+                return self.error("empty brackets", prev.start, token.end)
+            return self.error_at(f"unclosed '{prev.text}'", prev)
+        if prev.is_op("^", "**"):
+            return self.error_at(f"missing exponent after '{prev.text}'", prev)
+        if prev.is_op("="):
+            return self.error_at("missing right-hand side after '='", prev)
+        if prev.is_op(","):
+            return self.error_at("missing argument after ','", prev)
+        return self.error_at(f"missing operand after '{prev.text}'", prev)
+
+    def group(self, opening: _Token) -> _Node:
+        self.contexts.append("group")
+        inner = self.expression(0)
+        closing = self.closing(opening)
+        self.contexts.pop()
+        inner.start, inner.end = opening.start, closing.end
+        return inner
+
+    def closing(self, opening: _Token) -> _Token:
+        """Consume the bracket that closes `opening`, or explain why it is missing."""
+        token = self.peek()
+        if token.is_op(_CLOSING[opening.text]):
+            return self.advance()
+        if token.is_op(")", "]"):
+            raise self.error_at(f"'{token.text}' does not match '{opening.text}'", token)
+        if token.is_op("="):
+            raise self.error_at(f"unclosed '{opening.text}' before '='", opening)
+        if token.is_op(","):
+            raise self.error_at("',' is only allowed between function arguments", token)
+        raise self.error_at(f"unclosed '{opening.text}'", opening)
+
+    def name(self, token: _Token) -> _Node:
+        word = token.text
+        if word in self.params or word in CONSTANTS:
+            return self.new(_Named(token.start, token.end, word, word in self.params))
+        followed_by_call = self.peek().is_op("(")
+        if word in USER_FUNCTIONS:
+            if followed_by_call:
+                return self.call(token)
+            raise self.error_at(f"function '{word}' needs arguments in parentheses", token)
+        raise self.error_at(_unknown_name_message(word, followed_by_call, self.params), token)
+
+    def call(self, name: _Token) -> _Node:
+        opening = self.advance()
+        self.contexts.append("call")
+        args: list[_Node] = []
+        if self.peek().is_op(")", "]"):
+            closing = self.closing(opening)
+        else:
+            while True:
+                args.append(self.expression(0))
+                if self.peek().is_op(","):
+                    self.advance()
+                    continue
+                closing = self.closing(opening)
+                break
+        self.contexts.pop()
+        arity = USER_FUNCTIONS[name.text].arity
+        if len(args) != arity:
+            noun = "argument" if arity == 1 else "arguments"
+            raise self.error(
+                f"{name.text} takes {arity} {noun}, got {len(args)}", name.start, closing.end
+            )
+        return self.new(_Call(name.start, closing.end, name.text, args))
+
+
+def _unknown_name_message(word: str, followed_by_call: bool, params: Mapping[str, object]) -> str:
+    """`unknown name 'foo'` plus a hint when a likely intended spelling is cheap to find."""
+    shown = _quote(word)
+    if followed_by_call:
+        message = f"unknown function {shown}"
+        lower = word.lower()
+        if lower in USER_FUNCTIONS:
+            return f"{message}; did you mean '{lower}'?"
+        if lower in _FUNCTION_ALIASES and _FUNCTION_ALIASES[lower] in USER_FUNCTIONS:
+            return f"{message}; did you mean '{_FUNCTION_ALIASES[lower]}'?"
+        if lower in _POWER_FUNCTIONS:
+            return f"{message}; use '^' for powers"
+        close = difflib.get_close_matches(word, sorted(USER_FUNCTIONS), n=1)
+        return f"{message}; did you mean '{close[0]}'?" if close else message
+    message = f"unknown name {shown}"
+    known = [*_VARIABLES, *params, *CONSTANTS]
+    lower = word.lower()
+    if lower in known or lower in USER_FUNCTIONS:
+        return f"{message}; did you mean '{lower}'?"
+    digits = re.fullmatch(r"([xyz]+)(\d+)", word)
+    if digits:
+        return f"{message}; did you mean '{digits.group(1)}^{digits.group(2)}'?"
+    for cut in range(1, len(word)):
+        head, tail = word[:cut], word[cut:]
+        if set(tail) <= set(_VARIABLES):
+            if head in USER_FUNCTIONS:
+                return f"{message}; did you mean '{head}({tail})'?"
+            if head in params or head in CONSTANTS:
+                return f"{message}; did you mean '{head}*{tail}'?"
+        if set(head) <= set(_VARIABLES) and (tail in params or tail in CONSTANTS):
+            return f"{message}; did you mean '{head}*{tail}'?"
+    close = difflib.get_close_matches(word, sorted(params), n=1)
+    return f"{message}; did you mean '{close[0]}'?" if close else message
+
+
+# --------------------------------------------------------------------------- analysis
+
+
+@dataclass(frozen=True)
+class _Info:
+    """What the limit checks know about a node before any sympy object exists."""
+
+    constant: bool  # does not depend on x, y, z
+    value: Fraction | None  # its exact value, when it is a rational constant
+    degree: int  # estimated total degree in x, y, z (opaque parts count 1)
+    terms: int  # estimated monomials after expansion, capped at max_terms + 1
+    polynomial: bool  # a polynomial in x, y, z with rational coefficients
+    size: int  # estimated sympy tree size (the real-root rule copies its base)
+
+
+_LEAF_CONSTANT = _Info(True, None, 0, 1, False, 1)
+
+
+@lru_cache(maxsize=None)
+def _argument_copies(name: str) -> tuple[int, ...]:
+    """How many times a table function's sympy form repeats each argument (cbrt: twice)."""
+    function = USER_FUNCTIONS[name]
+    dummies = [sympy.Dummy(real=True) for _ in range(function.arity)]
+    built = function.build(*dummies)
+    return tuple(max(1, built.count(d)) for d in dummies)
+
+
+class _Analyzer:
+    """Bottom-up limit checks and exact folding of rational constants."""
+
+    def __init__(
+        self,
+        source: Source,
+        params: Mapping[str, tuple[sympy.Expr, Fraction | None]],
+        limits: Limits,
+    ):
+        self.source = source
+        self.params = params
+        self.limits = limits
+
+    def analyze(self, root: _Node) -> dict[_Node, _Info]:
+        info: dict[_Node, _Info] = {}
+        for node in _postorder(root):
+            result = self.visit(node, info)
+            self.check_growth(node, result)
+            info[node] = result
+        return info
+
+    def fail(self, message: str, node: _Node) -> InputError:
+        return InputError(message, self.source, node.start, node.end - node.start)
+
+    def limit(self, message: str, node: _Node) -> LimitError:
+        return LimitError(f"too complex: {message}", self.source, node.start, node.end - node.start)
+
+    def check_growth(self, node: _Node, info: _Info) -> None:
+        limits = self.limits
+        if info.size > limits.max_nodes:
+            raise self.limit(
+                f"expression size exceeds the limit of {limits.max_nodes} nodes (--max-nodes)",
+                node,
+            )
+        if info.degree > limits.max_degree:
+            raise self.limit(
+                f"degree {info.degree} exceeds the limit of {limits.max_degree} (--max-degree)",
+                node,
+            )
+        if info.terms > limits.max_terms:
+            raise self.limit(
+                f"expansion would exceed the limit of {limits.max_terms} terms (--max-terms)",
+                node,
+            )
+
+    def checked_value(self, value: Fraction, node: _Node) -> Fraction:
+        if _too_many_digits(value, self.limits.max_constant_digits):
+            raise _constant_digits_error(
+                "constant value", self.limits, self.source, node.start, node.end - node.start
+            )
+        return value
+
+    def cap_terms(self, terms: int, degree: int, polynomial: bool) -> int:
+        """Cap a term estimate: at max_terms + 1, and for a polynomial in x, y, z at the
+        number of monomials of its degree, C(degree + 3, 3)."""
+        if polynomial:
+            terms = min(terms, math.comb(degree + 3, 3))
+        return min(terms, self.limits.max_terms + 1)
+
+    def visit(self, node: _Node, info: Mapping[_Node, _Info]) -> _Info:
+        if isinstance(node, _Num):
+            return _Info(True, node.value, 0, 1, True, 1)
+        if isinstance(node, _Var):
+            return _Info(False, None, 1, 1, True, 1)
+        if isinstance(node, _Named):
+            exact = self.params[node.name][1] if node.is_param else None
+            return _Info(True, exact, 0, 1, exact is not None, 1)
+        if isinstance(node, _Neg):
+            inner = info[node.operand]
+            value = None if inner.value is None else -inner.value
+            return _Info(
+                inner.constant, value, inner.degree, inner.terms, inner.polynomial, inner.size + 1
+            )
+        if isinstance(node, _Sum):
+            return self.visit_sum(node, [info[t] for t in node.terms])
+        if isinstance(node, _Product):
+            return self.visit_product(node, [info[f] for f in node.factors])
+        if isinstance(node, _Power):
+            return self.visit_power(node, info[node.base], info[node.exponent])
+        if isinstance(node, _Call):
+            return self.visit_call(node, [info[a] for a in node.args])
+        raise AssertionError(f"unknown node {node!r}")  # pragma: no cover
+
+    def visit_sum(self, node: _Sum, parts: list[_Info]) -> _Info:
+        value: Fraction | None = Fraction(0)
+        for part, negative in zip(parts, node.negative):
+            if value is None or part.value is None:
+                value = None
+                continue
+            value = self.checked_value(value - part.value if negative else value + part.value, node)
+        degree = max(p.degree for p in parts)
+        polynomial = all(p.polynomial for p in parts)
+        terms = self.cap_terms(sum(p.terms for p in parts), degree, polynomial)
+        return _Info(
+            all(p.constant for p in parts),
+            value,
+            degree,
+            terms,
+            polynomial,
+            1 + sum(p.size for p in parts),
+        )
+
+    def visit_product(self, node: _Product, parts: list[_Info]) -> _Info:
+        value: Fraction | None = Fraction(1)
+        terms = 1
+        for factor, part, divide in zip(node.factors, parts, node.divide):
+            if divide and part.value == 0:
+                raise self.fail("division by zero", factor)
+            terms = min(terms * part.terms, self.limits.max_terms + 1)
+            if value is None or part.value is None:
+                value = None
+                continue
+            value = self.checked_value(value / part.value if divide else value * part.value, node)
+        degree = sum(p.degree for p in parts)
+        polynomial = all(
+            p.polynomial and (not divide or p.constant) for p, divide in zip(parts, node.divide)
+        )
+        return _Info(
+            all(p.constant for p in parts),
+            value,
+            degree,
+            self.cap_terms(terms, degree, polynomial),
+            polynomial,
+            1 + sum(p.size for p in parts),
+        )
+
+    def visit_power(self, node: _Power, base: _Info, exponent: _Info) -> _Info:
+        size = 1 + base.size + exponent.size
+        negative_base = base.value is not None and base.value < 0
+        real_base_message = (
+            "negative base needs an integer exponent or a fraction with an odd denominator"
+        )
+        if exponent.value is None:
+            if not exponent.constant and not base.constant:
+                raise self.fail(
+                    "exponent must not depend on x, y, z when the base does", node.exponent
+                )
+            if negative_base:
+                raise self.fail(real_base_message, node)
+            constant = base.constant and exponent.constant
+            return _Info(constant, None, 0 if constant else 1, 1, False, size)
+        power = exponent.value
+        if power.denominator % 2 == 0 and negative_base:
+            raise self.fail(real_base_message, node)
+        if base.value is not None:
+            return self.fold_power(node, base.value, power, size)
+        if abs(power) > self.limits.max_exponent:
+            raise self.limit(
+                f"exponent {_show(power)} exceeds the limit of {self.limits.max_exponent} "
+                f"(--max-exponent)",
+                node.exponent,
+            )
+        if power.denominator != 1:
+            if power.denominator % 2:  # real root: sign(b) * |b|^(p/q) repeats b
+                size = 4 + 2 * base.size + exponent.size
+            constant = base.constant
+            return _Info(constant, None, 0 if constant else 1, 1, False, size)
+        n = abs(power.numerator)
+        degree = n * base.degree
+        polynomial = base.polynomial and power >= 0
+        terms = self.cap_terms(_power_terms(base.terms, n, self.limits.max_terms), degree, polynomial)
+        return _Info(base.constant, None, degree, terms, polynomial, size)
+
+    def fold_power(self, node: _Power, base: Fraction, power: Fraction, size: int) -> _Info:
+        """A rational constant to a rational power: bound the result's size, then fold."""
+        if base not in (0, 1, -1):
+            bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length()) - 1
+            digits_bound = self.limits.max_constant_digits * 100_000 * power.denominator
+            if abs(power.numerator) * bits * _LOG10_2 > digits_bound:
+                raise _constant_digits_error(
+                    "constant power", self.limits, self.source, node.start, node.end - node.start
+                )
+        if power.denominator != 1:  # e.g. 2^(1/3): sympy keeps it exact
+            return _Info(True, None, 0, 1, False, size)
+        if base == 0 and power < 0:
+            raise self.fail("division by zero", node)
+        value = self.checked_value(base ** power.numerator, node)
+        return _Info(True, value, 0, 1, True, size)
+
+    def visit_call(self, node: _Call, args: list[_Info]) -> _Info:
+        constant = all(a.constant for a in args)
+        copies = _argument_copies(node.name)
+        size = 1 + sum(n * a.size for n, a in zip(copies, args))
+        return _Info(constant, None, 0 if constant else 1, 1, False, size)
+
+
+def _power_terms(terms: int, n: int, max_terms: int) -> int:
+    """Monomials of (t terms)^n, C(t + n - 1, n), stopping as soon as it passes max_terms."""
+    result = 1
+    for i in range(1, n + 1):
+        result = result * (terms + i - 1) // i
+        if result > max_terms:
+            return max_terms + 1
+    return result
+
+
+# --------------------------------------------------------------------------- sympy
+
+
+class _Builder:
+    """Build the sympy expression bottom-up from a checked AST."""
+
+    def __init__(
+        self,
+        source: Source,
+        params: Mapping[str, tuple[sympy.Expr, Fraction | None]],
+        info: Mapping[_Node, _Info],
+    ):
+        self.source = source
+        self.params = params
+        self.info = info
+
+    def fail(self, message: str, node: _Node) -> InputError:
+        return InputError(message, self.source, node.start, node.end - node.start)
+
+    def build(self, root: _Node) -> sympy.Expr:
+        built: dict[_Node, sympy.Expr] = {}
+        order = _postorder(root)
+        for node in order:
+            built[node] = self.make(node, built)
+        result = built[root]
+        if result.has(*(atom for atom, _ in _NON_REAL_MESSAGES)):
+            raise self.locate_non_real(order, built)
+        if not result.free_symbols & {X, Y, Z}:
+            raise self.fail("equation does not depend on x, y or z", root)
+        return result
+
+    def locate_non_real(self, order: list[_Node], built: Mapping[_Node, sympy.Expr]) -> InputError:
+        """The innermost node whose value is not a finite real number."""
+        for node in order:
+            for atom, message in _NON_REAL_MESSAGES:
+                if built[node].has(atom):
+                    return self.fail(message, node)
+        raise AssertionError("no node holds the non-real value")  # pragma: no cover
+
+    def make(self, node: _Node, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
+        value = self.info[node].value
+        if value is not None:
+            return sympy.Rational(value.numerator, value.denominator)
+        if isinstance(node, _Var):
+            return _VARIABLES[node.name]
+        if isinstance(node, _Named):
+            return self.params[node.name][0] if node.is_param else CONSTANTS[node.name]
+        if isinstance(node, _Neg):
+            return -built[node.operand]
+        if isinstance(node, _Sum):
+            return sympy.Add(
+                *(-built[t] if neg else built[t] for t, neg in zip(node.terms, node.negative))
+            )
+        if isinstance(node, _Product):
+            return self.make_product(node, built)
+        if isinstance(node, _Power):
+            return self.make_power(node, built)
+        if isinstance(node, _Call):
+            return self.make_call(node, built)
+        raise AssertionError(f"unknown node {node!r}")  # pragma: no cover
+
+    def make_product(self, node: _Product, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
+        factors = []
+        for factor, divide in zip(node.factors, node.divide):
+            expr = built[factor]
+            if divide:
+                if expr == 0:
+                    raise self.fail("division by zero", factor)
+                expr = sympy.Pow(expr, -1)
+            factors.append(expr)
+        return sympy.Mul(*factors)
+
+    def make_power(self, node: _Power, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
+        base = built[node.base]
+        power = self.info[node.exponent].value
+        if power is None:
+            return sympy.Pow(base, built[node.exponent])
+        if power.denominator == 1:
+            return sympy.Pow(base, sympy.Integer(power.numerator))
+        exponent = sympy.Rational(power.numerator, power.denominator)
+        if power.denominator % 2 == 0:
+            return sympy.Pow(base, exponent)
+        magnitude = sympy.Pow(sympy.Abs(base), exponent)
+        return sympy.sign(base) * magnitude if power.numerator % 2 else magnitude
+
+    def make_call(self, node: _Call, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
+        function = USER_FUNCTIONS[node.name]
+        args = [built[a] for a in node.args]
+        if function.sympy_name in _UNEVALUATED:
+            expr = function.build(*args, evaluate=False)
+        else:
+            expr = function.build(*args)
+        if all(self.info[a].value is not None for a in node.args):
+            # Rational arguments keep evalf cheap; it finds e.g. asin(2), which sympy
+            # leaves unevaluated although it is not real.
+            approx = expr.evalf(15)
+            if approx.has(sympy.nan):
+                raise self.fail("value is undefined", node)
+            if approx.has(sympy.zoo, sympy.oo, -sympy.oo):
+                raise self.fail("value is infinite", node)
+            if approx.is_real is False:
+                raise self.fail("value is not a real number", node)
+        return expr
+

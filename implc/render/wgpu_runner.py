@@ -1,0 +1,190 @@
+"""Run a generated WGSL program headlessly with wgpu-py (Vulkan; lavapipe here).
+
+The compute shader (templates/wgsl/program.wgsl.j2) writes colour into an rgba32float
+storage texture and (hit, t, steps, |S|) into a storage buffer; `frame()` dispatches it,
+copies both into mappable buffers in the same submission and maps them, which waits for
+the GPU. Texture row 0 is the top of the image (WebGPU's texel (0, 0) is the first row in
+memory), so nothing is flipped, unlike GL.
+
+This module is not named `wgpu.py`: that would shadow the wgpu package.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from functools import lru_cache
+
+import numpy as np
+
+from ..errors import ToolError
+from .result import RenderResult
+from .scene import View
+
+WORKGROUP = 8  # the workgroup size (8 x 8) in templates/wgsl/program.wgsl.j2
+COLOR_FORMAT = "rgba32float"  # storage-writable in core WebGPU, and exact like GL's f4
+UNIFORM_FLOATS = 20  # struct Uniforms: 80 bytes (README "Drop-in contract (WGSL)")
+
+
+@lru_cache(maxsize=1)
+def device():
+    """One wgpu device per process (creating one costs ~0.5 s on lavapipe).
+
+    Asks for the adapter's largest storage binding so big frames fit the aux buffer.
+    """
+    os.environ.setdefault("XDG_RUNTIME_DIR", "/tmp")
+    try:
+        import wgpu
+    except ImportError as err:  # pragma: no cover - depends on the install
+        raise ToolError("wgpu is not installed (run `make setup`)") from err
+    _vulkan_only()
+    try:
+        adapter = wgpu.gpu.request_adapter_sync(power_preference="low-power")
+    except Exception as err:  # wgpu raises RuntimeError or its own GPUError types
+        raise ToolError(f"no wgpu adapter (install mesa-vulkan-drivers): {err}") from err
+    if adapter is None:
+        raise ToolError("no wgpu adapter (install mesa-vulkan-drivers for lavapipe)")
+    limits = {
+        key: adapter.limits[key]
+        for key in ("max-storage-buffer-binding-size", "max-buffer-size")
+        if key in adapter.limits
+    }
+    try:
+        return adapter.request_device_sync(required_limits=limits)
+    except Exception as err:
+        raise ToolError(f"cannot create a wgpu device: {err}") from err
+
+
+def _vulkan_only() -> None:
+    """Keep wgpu off its GL backend: probing it through EGL makes wgpu's own context
+    current and breaks moderngl's in the same process (GL and wgpu render side by side in
+    tests and `bench`). Only possible before wgpu creates its instance."""
+    try:
+        from wgpu.backends.wgpu_native.extras import set_instance_extras
+
+        set_instance_extras(backends=["Vulkan"])
+    except (ImportError, RuntimeError):  # another wgpu user created the instance first
+        pass
+
+
+def adapter_name() -> str:
+    return str(device().adapter.info.get("device", "unknown"))
+
+
+def _uniforms(view: View, width: int, height: int) -> bytes:
+    """The 80-byte `Uniforms` block, laid out as the WGSL uniform address space requires
+    (vec3<f32> aligned to 16 bytes): offsets 0 resolution, 8 fov_y, 12 clip_radius,
+    16 eye, 32 target, 48 up, 64 clip_center."""
+    data = np.zeros(UNIFORM_FLOATS, np.float32)
+    data[0:2] = (width, height)
+    data[2] = view.fov_y_deg
+    data[3] = view.clip_radius
+    data[4:7] = view.eye
+    data[8:11] = view.target
+    data[12:15] = view.up
+    data[16:19] = view.clip_center
+    return data.tobytes()
+
+
+class WgpuRunner:
+    """A compiled compute pipeline and its output resources; `frame()` renders once."""
+
+    def __init__(self, program: str, view: View, width: int, height: int):
+        import wgpu
+
+        dev = device()
+        self.device, self.width, self.height = dev, width, height
+        aux_bytes = width * height * 16
+        if aux_bytes > dev.limits["max-storage-buffer-binding-size"]:
+            raise ToolError(f"wgpu: a {width}x{height} aux buffer ({aux_bytes} bytes) exceeds "
+                            "the device's storage binding limit; render a smaller image")
+        try:
+            module = dev.create_shader_module(code=program, label="implc.wgsl")
+            layout = dev.create_bind_group_layout(entries=[
+                {"binding": 0, "visibility": wgpu.ShaderStage.COMPUTE,
+                 "buffer": {"type": wgpu.BufferBindingType.uniform}},
+                {"binding": 1, "visibility": wgpu.ShaderStage.COMPUTE,
+                 "storage_texture": {"access": wgpu.StorageTextureAccess.write_only,
+                                     "format": COLOR_FORMAT, "view_dimension": "2d"}},
+                {"binding": 2, "visibility": wgpu.ShaderStage.COMPUTE,
+                 "buffer": {"type": wgpu.BufferBindingType.storage}},
+            ])
+            self.pipeline = dev.create_compute_pipeline(
+                layout=dev.create_pipeline_layout(bind_group_layouts=[layout]),
+                compute={"module": module, "entry_point": "main"},
+            )
+        except Exception as err:
+            raise ToolError(f"wgpu rejected the shader: {err}") from err
+        usage = wgpu.BufferUsage
+        self.uniforms = dev.create_buffer_with_data(
+            data=_uniforms(view, width, height), usage=usage.UNIFORM)
+        self.color = dev.create_texture(
+            size=(width, height, 1), format=COLOR_FORMAT,
+            usage=wgpu.TextureUsage.STORAGE_BINDING | wgpu.TextureUsage.COPY_SRC)
+        self.aux = dev.create_buffer(size=aux_bytes, usage=usage.STORAGE | usage.COPY_SRC)
+        # texture-to-buffer copies need rows padded to 256 bytes
+        self.row_bytes = -(-width * 16 // 256) * 256
+        self.color_read = dev.create_buffer(
+            size=self.row_bytes * height, usage=usage.MAP_READ | usage.COPY_DST)
+        self.aux_read = dev.create_buffer(size=aux_bytes, usage=usage.MAP_READ | usage.COPY_DST)
+        self.bind_group = dev.create_bind_group(layout=layout, entries=[
+            {"binding": 0, "resource": {"buffer": self.uniforms}},
+            {"binding": 1, "resource": self.color.create_view()},
+            {"binding": 2, "resource": {"buffer": self.aux}},
+        ])
+
+    def dispatch(self) -> None:
+        """Record and submit one frame: the compute pass and the copies out of it."""
+        encoder = self.device.create_command_encoder()
+        compute = encoder.begin_compute_pass()
+        compute.set_pipeline(self.pipeline)
+        compute.set_bind_group(0, self.bind_group)
+        compute.dispatch_workgroups(-(-self.width // WORKGROUP), -(-self.height // WORKGROUP), 1)
+        compute.end()
+        encoder.copy_texture_to_buffer(
+            {"texture": self.color},
+            {"buffer": self.color_read, "bytes_per_row": self.row_bytes,
+             "rows_per_image": self.height},
+            (self.width, self.height, 1),
+        )
+        encoder.copy_buffer_to_buffer(self.aux, 0, self.aux_read, 0, self.aux.size)
+        self.device.queue.submit([encoder.finish()])
+
+    def read(self) -> RenderResult:
+        """Map the copies (this waits for the frame) into a RenderResult, row 0 on top."""
+        import wgpu
+
+        arrays = []
+        for buffer, row in ((self.color_read, self.row_bytes), (self.aux_read, self.width * 16)):
+            buffer.map_sync(wgpu.MapMode.READ)
+            raw = np.frombuffer(buffer.read_mapped(), np.float32).reshape(self.height, row // 4)
+            arrays.append(raw[:, : self.width * 4].reshape(self.height, self.width, 4).copy())
+            buffer.unmap()
+        color, aux = arrays
+        return RenderResult(
+            color=np.ascontiguousarray(color[..., :3]),
+            hit=aux[..., 0] > 0.5,
+            t=np.ascontiguousarray(aux[..., 1]),
+            steps=np.ascontiguousarray(aux[..., 2]),
+            residual=np.ascontiguousarray(aux[..., 3]),
+        )
+
+    def frame(self) -> RenderResult:
+        start = time.perf_counter()
+        self.dispatch()
+        result = self.read()
+        result.timing["frame"] = time.perf_counter() - start
+        return result
+
+    def release(self) -> None:
+        for buffer in (self.uniforms, self.aux, self.color_read, self.aux_read):
+            buffer.destroy()
+        self.color.destroy()
+
+
+def open_wgpu_runner(surface, method, constants, width: int, height: int) -> WgpuRunner:
+    """The `wgpu` entry of render.run.BACKENDS: emit the WGSL program and compile it."""
+    from ..emit import emit
+
+    program = emit(surface, "wgsl", method, constants)
+    return WgpuRunner(program, surface.view, width, height)

@@ -1,0 +1,51 @@
+"""`implc show`: what implc understood and what it will compute, for people to read."""
+
+from __future__ import annotations
+
+import sympy
+
+from .derive import Derivatives, polynomial_degree
+from .emit import build_functions
+from .methods import Method
+from .surface import Surface
+from .textform import to_text
+
+
+def describe(surface: Surface, method: Method) -> str:
+    d = Derivatives(surface.expr)
+    degree = polynomial_degree(surface.expr)
+    lines = [
+        f"surface:   {surface.name} ({surface.origin})",
+        f"equation:  {surface.equation}",
+        f"degree:    {degree if degree is not None else 'not a polynomial'}",
+    ]
+    if surface.params:
+        lines.append("params:    " + ", ".join(f"{k} = {v}" for k, v in surface.params.items()))
+    lines += [
+        "",
+        "derived (point form: p = (x, y, z), unit ray direction D = (dx, dy, dz)):",
+        f"  dS/dx      = {_short(d.gradient[0])}",
+        f"  dS/dy      = {_short(d.gradient[1])}",
+        f"  dS/dz      = {_short(d.gradient[2])}",
+        f"  Laplacian  = {_short(d.laplacian)}",
+        f"  F'(t)      = grad S . D = {_short(d.directional)}",
+        f"  F''(t)     = D^T H D = {_short(d.second_directional)}",
+        "",
+        f"shader functions for method '{method.name}' (ops before -> after optimization):",
+    ]
+    total_before = total_after = 0
+    for name, program in build_functions(surface.expr, method).items():
+        quantities = ", ".join(method.all_functions()[name])
+        lines.append(
+            f"  {name:<5} ({quantities}): {program.ops_before:>6} -> {program.ops_after:<6}"
+            f" ({len(program.assignments)} temporaries)"
+        )
+        total_before += program.ops_before
+        total_after += program.ops_after
+    lines.append(f"  total: {total_before} -> {total_after}")
+    return "\n".join(lines)
+
+
+def _short(expr: sympy.Expr, limit: int = 200) -> str:
+    text = to_text(expr)[: -len(" = 0")]
+    return text if len(text) <= limit else text[:limit] + " ..."
