@@ -34,8 +34,10 @@ Semantics:
   integer exponent or a fraction with an odd denominator.
 - Exponents of expressions that depend on x, y, z must be constant; a constant base may
   have a variable exponent (`2^x`, `e^(-x^2)`).
-- Division by a constant zero is an error, and so is a constant sub-expression that sympy
-  evaluates to a non-real, infinite or undefined value (`sqrt(-1)`, `log(0)`).
+- Division by a constant zero is an error, and so is any sub-expression that sympy
+  evaluates to a non-real, infinite or undefined value (`sqrt(-1)`, `log(0)`, `asin(2)`,
+  `sqrt(-x^2)`). Constants sympy leaves unevaluated (`sqrt(1 - pi)`) are not evaluated
+  numerically, except calls with rational arguments: they are NaN in a shader.
 - `min` and `max` are built unevaluated: sympy compares every pair of (flattened)
   arguments symbolically when it evaluates them, which takes minutes for nested calls.
 
@@ -54,7 +56,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
-from functools import lru_cache
+from functools import cache
 
 import sympy
 
@@ -91,8 +93,9 @@ class Limits:
 
 _WHITESPACE = " \t\n\r"
 _OPERATORS = ("**", "==", "+", "-", "*", "/", "^", "=", "(", ")", "[", "]", ",")
-_NUMBER_RE = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_NUMBER_PARTS_RE = re.compile(r"(\d*)(?:\.(\d*))?(?:[eE]([+-]?\d+))?")
+_DIGITS = frozenset("0123456789")
+_NUMBER_RE = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+_NUMBER_PARTS_RE = re.compile(r"(\d*)(?:\.(\d*))?(?:[eE]([+-]?\d+))?", re.ASCII)
 _MALFORMED_NUMBER_RE = re.compile(r"[0-9.]*")
 _WORD_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
@@ -203,8 +206,8 @@ def parse_equation(
         return _Builder(source, values, info).build(root)
     except RecursionError:
         raise LimitError(
-            f"too complex: nesting depth exceeds what can be parsed with the limit of "
-            f"{limits.max_depth} (--max-depth)",
+            f"too complex: nesting is too deep to parse with the limit of {limits.max_depth} "
+            f"(--max-depth)",
             source,
             0,
             1,
@@ -227,9 +230,13 @@ def parse_number(
     if not stripped:
         raise InputError("empty number", source, 0, max(1, len(text)))
     match = re.fullmatch(
-        r"([+-]?)(" + _NUMBER_RE.pattern + r")(?:[ \t]*/[ \t]*([+-]?)("
-        + _NUMBER_RE.pattern + r"))?",
+        r"([+-]?)("
+        + _NUMBER_RE.pattern
+        + r")(?:[ \t]*/[ \t]*([+-]?)("
+        + _NUMBER_RE.pattern
+        + r"))?",
         stripped,
+        re.ASCII,
     )
     if match is None:
         if stripped.lstrip("+-").lower() in ("nan", "inf", "infinity"):
@@ -273,13 +280,9 @@ def check_param_name(name: str, source: Source | None = None) -> None:
             f"parameter name '{name}' would read as a product of x, y, z", source, 0, length
         )
     if name in USER_FUNCTIONS:
-        raise InputError(
-            f"parameter name '{name}' shadows the function {name}", source, 0, length
-        )
+        raise InputError(f"parameter name '{name}' shadows the function {name}", source, 0, length)
     if name in CONSTANTS:
-        raise InputError(
-            f"parameter name '{name}' shadows the constant {name}", source, 0, length
-        )
+        raise InputError(f"parameter name '{name}' shadows the constant {name}", source, 0, length)
 
 
 # --------------------------------------------------------------------------- helpers
@@ -357,15 +360,15 @@ def _literal_value(text: str, source: Source | None, start: int, limits: Limits)
             len(text),
         )
     if len(significant) > limits.max_constant_digits:
-        raise _constant_digits_error(
-            f"number {_quote(text)}", limits, source, start, len(text)
-        )
+        raise _constant_digits_error(f"number {_quote(text)}", limits, source, start, len(text))
     if scale >= 0:
         return Fraction(int(significant) * 10**scale)
     return Fraction(int(significant), 10**-scale)
 
 
-def _param_values(params: Mapping[str, sympy.Expr]) -> dict[str, tuple[sympy.Expr, Fraction | None]]:
+def _param_values(
+    params: Mapping[str, sympy.Expr],
+) -> dict[str, tuple[sympy.Expr, Fraction | None]]:
     """Check parameter names; keep each value with its exact rational form when it has one."""
     values: dict[str, tuple[sympy.Expr, Fraction | None]] = {}
     for name, value in params.items():
@@ -409,14 +412,16 @@ def _tokenize(text: str, params: Mapping[str, object]) -> list[_Token]:
         if ch in _WHITESPACE:
             pos += 1
             continue
-        if ch.isdigit() and ch.isascii() or (ch == "." and text[pos + 1 : pos + 2].isdigit()):
+        if ch in _DIGITS or (ch == "." and text[pos + 1 : pos + 2] in _DIGITS):
             match = _NUMBER_RE.match(text, pos)
             assert match is not None
             end = match.end()
             if text[end : end + 1] == ".":
                 end = _MALFORMED_NUMBER_RE.match(text, end).end()
                 literal = text[pos:end]
-                tokens.append(_Token("bad", literal, pos, end, f"malformed number {_quote(literal)}"))
+                tokens.append(
+                    _Token("bad", literal, pos, end, f"malformed number {_quote(literal)}")
+                )
                 break
             tokens.append(_Token("num", text[pos:end], pos, end))
             pos = end
@@ -424,11 +429,16 @@ def _tokenize(text: str, params: Mapping[str, object]) -> list[_Token]:
         word = _WORD_RE.match(text, pos)
         if word is not None:
             name = word.group()
-            if name not in params and name not in CONSTANTS and name not in USER_FUNCTIONS and (
-                set(name) <= set(_VARIABLES)
+            if (
+                name not in params
+                and name not in CONSTANTS
+                and name not in USER_FUNCTIONS
+                and (set(name) <= set(_VARIABLES))
             ):
                 # `xyz` is x*y*z: one variable token per letter, each with its own column
-                tokens.extend(_Token("var", letter, pos + i, pos + i + 1) for i, letter in enumerate(name))
+                tokens.extend(
+                    _Token("var", letter, pos + i, pos + i + 1) for i, letter in enumerate(name)
+                )
             else:
                 tokens.append(_Token("name", name, pos, word.end()))
             pos = word.end()
@@ -549,7 +559,11 @@ def _postorder(root: _Node) -> list[_Node]:
 
 
 class _Parser:
-    """Pratt parser over the token list; one Python frame pair per nesting level."""
+    """Pratt parser over the token list.
+
+    Each nesting level (bracket, call, sign, operator operand) costs two or three Python
+    frames, so `max_depth` keeps recursion well inside the interpreter's limit.
+    """
 
     def __init__(
         self,
@@ -728,7 +742,8 @@ class _Parser:
         if prev.is_op("(", "["):
             if token.is_op(")", "]"):
                 return self.error("empty brackets", prev.start, token.end)
-            return self.error_at(f"unclosed '{prev.text}'", prev)
+            before = " before '='" if token.is_op("=") else ""
+            return self.error_at(f"unclosed '{prev.text}'{before}", prev)
         if prev.is_op("^", "**"):
             return self.error_at(f"missing exponent after '{prev.text}'", prev)
         if prev.is_op("="):
@@ -808,11 +823,13 @@ def _unknown_name_message(word: str, followed_by_call: bool, params: Mapping[str
         close = difflib.get_close_matches(word, sorted(USER_FUNCTIONS), n=1)
         return f"{message}; did you mean '{close[0]}'?" if close else message
     message = f"unknown name {shown}"
+    if len(word) > 32:  # the hints below cost O(len(word)^2)
+        return message
     known = [*_VARIABLES, *params, *CONSTANTS]
     lower = word.lower()
     if lower in known or lower in USER_FUNCTIONS:
         return f"{message}; did you mean '{lower}'?"
-    digits = re.fullmatch(r"([xyz]+)(\d+)", word)
+    digits = re.fullmatch(r"([xyz]+)([0-9]+)", word)
     if digits:
         return f"{message}; did you mean '{digits.group(1)}^{digits.group(2)}'?"
     for cut in range(1, len(word)):
@@ -843,10 +860,7 @@ class _Info:
     size: int  # estimated sympy tree size (the real-root rule copies its base)
 
 
-_LEAF_CONSTANT = _Info(True, None, 0, 1, False, 1)
-
-
-@lru_cache(maxsize=None)
+@cache
 def _argument_copies(name: str) -> tuple[int, ...]:
     """How many times a table function's sympy form repeats each argument (cbrt: twice)."""
     function = USER_FUNCTIONS[name]
@@ -940,7 +954,7 @@ class _Analyzer:
 
     def visit_sum(self, node: _Sum, parts: list[_Info]) -> _Info:
         value: Fraction | None = Fraction(0)
-        for part, negative in zip(parts, node.negative):
+        for part, negative in zip(parts, node.negative, strict=True):
             if value is None or part.value is None:
                 value = None
                 continue
@@ -960,7 +974,7 @@ class _Analyzer:
     def visit_product(self, node: _Product, parts: list[_Info]) -> _Info:
         value: Fraction | None = Fraction(1)
         terms = 1
-        for factor, part, divide in zip(node.factors, parts, node.divide):
+        for factor, part, divide in zip(node.factors, parts, node.divide, strict=True):
             if divide and part.value == 0:
                 raise self.fail("division by zero", factor)
             terms = min(terms * part.terms, self.limits.max_terms + 1)
@@ -970,7 +984,8 @@ class _Analyzer:
             value = self.checked_value(value / part.value if divide else value * part.value, node)
         degree = sum(p.degree for p in parts)
         polynomial = all(
-            p.polynomial and (not divide or p.constant) for p, divide in zip(parts, node.divide)
+            p.polynomial and (not divide or p.constant)
+            for p, divide in zip(parts, node.divide, strict=True)
         )
         return _Info(
             all(p.constant for p in parts),
@@ -1015,7 +1030,9 @@ class _Analyzer:
         n = abs(power.numerator)
         degree = n * base.degree
         polynomial = base.polynomial and power >= 0
-        terms = self.cap_terms(_power_terms(base.terms, n, self.limits.max_terms), degree, polynomial)
+        terms = self.cap_terms(
+            _power_terms(base.terms, n, self.limits.max_terms), degree, polynomial
+        )
         return _Info(base.constant, None, degree, terms, polynomial, size)
 
     def fold_power(self, node: _Power, base: Fraction, power: Fraction, size: int) -> _Info:
@@ -1031,13 +1048,13 @@ class _Analyzer:
             return _Info(True, None, 0, 1, False, size)
         if base == 0 and power < 0:
             raise self.fail("division by zero", node)
-        value = self.checked_value(base ** power.numerator, node)
+        value = self.checked_value(base**power.numerator, node)
         return _Info(True, value, 0, 1, True, size)
 
     def visit_call(self, node: _Call, args: list[_Info]) -> _Info:
         constant = all(a.constant for a in args)
         copies = _argument_copies(node.name)
-        size = 1 + sum(n * a.size for n, a in zip(copies, args))
+        size = 1 + sum(n * a.size for n, a in zip(copies, args, strict=True))
         return _Info(constant, None, 0 if constant else 1, 1, False, size)
 
 
@@ -1102,7 +1119,10 @@ class _Builder:
             return -built[node.operand]
         if isinstance(node, _Sum):
             return sympy.Add(
-                *(-built[t] if neg else built[t] for t, neg in zip(node.terms, node.negative))
+                *(
+                    -built[t] if neg else built[t]
+                    for t, neg in zip(node.terms, node.negative, strict=True)
+                )
             )
         if isinstance(node, _Product):
             return self.make_product(node, built)
@@ -1114,7 +1134,7 @@ class _Builder:
 
     def make_product(self, node: _Product, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
         factors = []
-        for factor, divide in zip(node.factors, node.divide):
+        for factor, divide in zip(node.factors, node.divide, strict=True):
             expr = built[factor]
             if divide:
                 if expr == 0:
@@ -1154,4 +1174,3 @@ class _Builder:
             if approx.is_real is False:
                 raise self.fail("value is not a real number", node)
         return expr
-

@@ -103,7 +103,9 @@ def _parse_param_args(params: Sequence[str]) -> dict[str, sympy.Rational]:
             raise InputError("expected NAME=VALUE", source, 0, len(arg))
         name = name.strip()
         check_param_name(name, Source("--param", arg))
-        values[name] = parse_number(value.strip(), Source("--param", arg, 1, len(name) + 2))
+        text = value.strip()
+        values[name] = parse_number(text, Source("--param", text, 1, len(arg) - len(value) + 1 +
+                                                 (len(value) - len(value.lstrip()))))
     return values
 
 

@@ -22,6 +22,13 @@ class _EquationPrinter(StrPrinter):
             return repr(float(expr))
         return super()._print_Rational(expr)
 
+    def _print_Mul(self, expr):
+        coeff, rest = expr.as_coeff_Mul()
+        if coeff.is_Rational and coeff.q > 1000 and rest != 1:
+            sign = "-" if coeff < 0 else ""
+            return f"{sign}{repr(float(abs(coeff)))}*{self.parenthesize(rest, 50, strict=True)}"
+        return super()._print_Mul(expr)
+
     def _print_Exp1(self, expr):
         return "e"
 

@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def test_wheel_finds_templates_and_examples(tmp_path):
     wheel_dir, site = tmp_path / "wheel", tmp_path / "site"
     subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation",
+        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps",
          "-w", str(wheel_dir), str(ROOT)],
         check=True, capture_output=True, timeout=300,
     )
