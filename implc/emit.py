@@ -7,7 +7,6 @@ strict: a name a template uses but emit does not give is an error, not an empty 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -19,7 +18,7 @@ from .derive import Derivatives
 from .errors import InputError
 from .methods import Constants, Method, get_method
 from .optimize import Program, optimize
-from .render.scene import SHADING, View
+from .render.scene import SHADING, View, light_directions
 from .resources import data_dir
 from .surface import Surface
 from .symbols import DIRECTION, POINT
@@ -120,7 +119,7 @@ def emit(
         "flavor": tgt.flavors[flavor],
         "flavor_name": flavor,
         "precision": precision,
-        "shading": _print_shading(printer),
+        "shading": _print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
     template = environment().get_template(f"{tgt.name}/{emit}.{tgt.name}.j2")
@@ -145,16 +144,16 @@ def _print_constants(c: Constants, printer) -> dict[str, str]:
     }
 
 
-def _print_shading(printer) -> dict:
+def _print_shading(view: View, printer) -> dict:
     f = printer.float_literal
 
     def vec(v) -> list[str]:
         return [f(x) for x in v]
 
-    lights = []
-    for light in SHADING.lights:
-        n = math.sqrt(sum(x * x for x in light.direction))
-        lights.append({"direction": vec(x / n for x in light.direction), "color": vec(light.color)})
+    lights = [
+        {"direction": vec(direction), "color": vec(light.color)}
+        for light, direction in zip(SHADING.lights, light_directions(view), strict=True)
+    ]
     return {
         "front": vec(SHADING.front),
         "back": vec(SHADING.back),

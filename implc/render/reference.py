@@ -101,7 +101,7 @@ def render_reference(
     residual[hit] = np.abs(_on(expr, env, hit.sum()))
 
     shape = (height, width)
-    color = shade(grad.reshape(*shape, 3), dirs.reshape(*shape, 3), hit.reshape(shape))
+    color = shade(grad.reshape(*shape, 3), dirs.reshape(*shape, 3), hit.reshape(shape), view)
     return RenderResult(
         color=color.astype(np.float32),
         hit=hit.reshape(shape),

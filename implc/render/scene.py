@@ -49,7 +49,15 @@ class View:
 
 @dataclass(frozen=True)
 class Light:
-    direction: Vec3  # towards the light, world space, normalized when used
+    """A directional light fixed to the camera of the surface's [view].
+
+    `direction` points towards the light in camera space: x = right, y = up, z = back
+    towards the viewer; `light_directions(view)` turns it into world space, once, so
+    shaders receive constant world-space vectors (moving the camera at run time through
+    the program's uniforms keeps the lights where the [view] put them).
+    """
+
+    direction: Vec3
     color: Vec3
 
 
@@ -65,8 +73,8 @@ class Shading:
     shininess: float = 48.0
     lights: tuple[Light, ...] = field(
         default=(
-            Light((0.45, 0.75, 0.50), (0.85, 0.85, 0.85)),
-            Light((-0.60, -0.20, 0.75), (0.35, 0.35, 0.40)),
+            Light((-0.45, 0.65, 0.60), (0.85, 0.85, 0.85)),  # key: upper left, in front
+            Light((0.70, -0.25, 0.45), (0.35, 0.35, 0.40)),  # fill: lower right
         )
     )
 
@@ -85,6 +93,16 @@ def camera_basis(view: View) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     right = normalize(np.cross(forward, np.asarray(view.up, dtype=np.float64)))
     up = np.cross(right, forward)
     return forward, right, up
+
+
+def light_directions(view: View, shading: Shading = SHADING) -> list[np.ndarray]:
+    """World-space unit vectors towards each light of `shading` for this camera."""
+    forward, right, up = camera_basis(view)
+    result = []
+    for light in shading.lights:
+        x, y, z = light.direction
+        result.append(normalize(x * right + y * up - z * forward))
+    return result
 
 
 def pixel_rays(view: View, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
@@ -121,15 +139,17 @@ def clip_sphere(
     return t_near, t_far, hit
 
 
-def shade(grad: np.ndarray, dirs: np.ndarray, hit: np.ndarray, shading: Shading = SHADING):
+def shade(
+    grad: np.ndarray, dirs: np.ndarray, hit: np.ndarray, view: View,
+    shading: Shading = SHADING,
+) -> np.ndarray:
     """Colour (H, W, 3) in [0, 1] from the surface gradient at each hit point."""
     n = normalize(grad)
     facing = np.sum(n * dirs, axis=-1, keepdims=True)
     base = np.where(facing < 0.0, np.asarray(shading.front), np.asarray(shading.back))
     n = np.where(facing < 0.0, n, -n)  # two-sided: the normal faces the viewer
     color = shading.ambient * base
-    for light in shading.lights:
-        ldir = normalize(np.asarray(light.direction, dtype=np.float64))
+    for light, ldir in zip(shading.lights, light_directions(view, shading), strict=True):
         diffuse = np.maximum(np.sum(n * ldir, axis=-1, keepdims=True), 0.0)
         half = normalize(ldir - dirs)
         spec = np.maximum(np.sum(n * half, axis=-1, keepdims=True), 0.0) ** shading.shininess

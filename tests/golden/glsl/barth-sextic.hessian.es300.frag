@@ -204,14 +204,14 @@ vec3 shade(vec3 g, vec3 rd) {
     n = front ? n : -n;
     vec3 color = 0.18*base;
     {
-        vec3 l = vec3(0.4466625002869186, 0.7444375004781977, 0.4962916669854651);
+        vec3 l = vec3(-0.16659992610114757, 0.8448907987080241, 0.5083345383520672);
         vec3 h = normalize(l - rd);
         float diffuse = max(dot(n, l), 0.0);
         float spec = pow(max(dot(n, h), 0.0), 48.0);
         color += vec3(0.85, 0.85, 0.85)*(diffuse*base + 0.35*spec);
     }
     {
-        vec3 l = vec3(-0.6115766297251506, -0.20385887657505022, 0.7644707871564382);
+        vec3 l = vec3(0.9967663915678143, -0.050770503400336044, -0.062282554743324114);
         vec3 h = normalize(l - rd);
         float diffuse = max(dot(n, l), 0.0);
         float spec = pow(max(dot(n, h), 0.0), 48.0);

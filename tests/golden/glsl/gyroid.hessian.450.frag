@@ -196,14 +196,14 @@ vec3 shade(vec3 g, vec3 rd) {
     n = front ? n : -n;
     vec3 color = 0.18*base;
     {
-        vec3 l = vec3(0.4466625002869186, 0.7444375004781977, 0.4962916669854651);
+        vec3 l = vec3(-0.17947443836455562, 0.8425861830535275, 0.5077769688564211);
         vec3 h = normalize(l - rd);
         float diffuse = max(dot(n, l), 0.0);
         float spec = pow(max(dot(n, h), 0.0), 48.0);
         color += vec3(0.85, 0.85, 0.85)*(diffuse*base + 0.35*spec);
     }
     {
-        vec3 l = vec3(-0.6115766297251506, -0.20385887657505022, 0.7644707871564382);
+        vec3 l = vec3(0.9980370771228838, -0.055504635097260606, -0.029003933711320807);
         vec3 h = normalize(l - rd);
         float diffuse = max(dot(n, l), 0.0);
         float spec = pow(max(dot(n, h), 0.0), 48.0);

@@ -181,14 +181,14 @@ vec3 shade(vec3 g, vec3 rd) {
     n = front ? n : -n;
     vec3 color = 0.18*base;
     {
-        vec3 l = vec3(0.4466625002869186, 0.7444375004781977, 0.4962916669854651);
+        vec3 l = vec3(-0.17188476163102112, 0.832612442726477, 0.5265094006151227);
         vec3 h = normalize(l - rd);
         float diffuse = max(dot(n, l), 0.0);
         float spec = pow(max(dot(n, h), 0.0), 48.0);
         color += vec3(0.85, 0.85, 0.85)*(diffuse*base + 0.35*spec);
     }
     {
-        vec3 l = vec3(-0.6115766297251506, -0.20385887657505022, 0.7644707871564382);
+        vec3 l = vec3(0.997111254924301, -0.07479896173655665, -0.013200781280615852);
         vec3 h = normalize(l - rd);
         float diffuse = max(dot(n, l), 0.0);
         float spec = pow(max(dot(n, h), 0.0), 48.0);

@@ -189,14 +189,14 @@ fn shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32> {
     n = select(-n, n, front);
     var color = 0.18f*base;
     {
-        let l = vec3<f32>(0.4466625002869186f, 0.7444375004781977f, 0.4962916669854651f);
+        let l = vec3<f32>(0.5116077700207464f, -0.19176730349184817f, 0.8375456948524447f);
         let h = normalize(l - rd);
         let diffuse = max(dot(n, l), 0.0f);
         let spec = pow(max(dot(n, h), 0.0f), 48.0f);
         color += vec3<f32>(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
-        let l = vec3<f32>(-0.6115766297251506f, -0.20385887657505022f, 0.7644707871564382f);
+        let l = vec3<f32>(0.010889168278871571f, 0.9977943662625204f, -0.0654815139483634f);
         let h = normalize(l - rd);
         let diffuse = max(dot(n, l), 0.0f);
         let spec = pow(max(dot(n, h), 0.0f), 48.0f);

@@ -198,14 +198,14 @@ fn shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32> {
     n = select(-n, n, front);
     var color = 0.18f*base;
     {
-        let l = vec3<f32>(0.4466625002869186f, 0.7444375004781977f, 0.4962916669854651f);
+        let l = vec3<f32>(-0.17188476163102112f, 0.832612442726477f, 0.5265094006151227f);
         let h = normalize(l - rd);
         let diffuse = max(dot(n, l), 0.0f);
         let spec = pow(max(dot(n, h), 0.0f), 48.0f);
         color += vec3<f32>(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
-        let l = vec3<f32>(-0.6115766297251506f, -0.20385887657505022f, 0.7644707871564382f);
+        let l = vec3<f32>(0.997111254924301f, -0.07479896173655665f, -0.013200781280615852f);
         let h = normalize(l - rd);
         let diffuse = max(dot(n, l), 0.0f);
         let spec = pow(max(dot(n, h), 0.0f), 48.0f);

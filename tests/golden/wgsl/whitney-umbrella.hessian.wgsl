@@ -185,14 +185,14 @@ fn shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32> {
     n = select(-n, n, front);
     var color = 0.18f*base;
     {
-        let l = vec3<f32>(0.4466625002869186f, 0.7444375004781977f, 0.4962916669854651f);
+        let l = vec3<f32>(0.3621507430936338f, -0.29852232272550006f, 0.883023930656073f);
         let h = normalize(l - rd);
         let diffuse = max(dot(n, l), 0.0f);
         let spec = pow(max(dot(n, h), 0.0f), 48.0f);
         color += vec3<f32>(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
-        let l = vec3<f32>(-0.6115766297251506f, -0.20385887657505022f, 0.7644707871564382f);
+        let l = vec3<f32>(0.011340269200379933f, 0.9981165812064549f, 0.06028837877403176f);
         let h = normalize(l - rd);
         let diffuse = max(dot(n, l), 0.0f);
         let spec = pow(max(dot(n, h), 0.0f), 48.0f);
