@@ -7,6 +7,7 @@ Exit codes: 0 ok, 1 bad input (equation, surface file, parameter), 2 bad command
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -51,6 +52,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("implc: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:  # `implc show x | head`: the reader left; not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except RecursionError:
         print("implc: error: too complex: expression nesting exceeds Python's limits",
               file=sys.stderr)
