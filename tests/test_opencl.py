@@ -149,10 +149,11 @@ def test_cl_agrees_with_gl(example, method):
     """The same method on OpenCL (PoCL) and GL (llvmpipe) at 96x96.
 
     Measured: hit masks identical (agreement 1.0) on all 15 surface x method pairs;
-    SSIM >= 0.9984 (miter/curvature; 0.9998 miter/taylor, cross-cap/taylor 0.99998, the
-    rest 1.0). The two drivers round float32 differently (FMA contraction, operation
-    order), which moves a refined t by ~1e-6 and a pixel near a silhouette or a double line
-    at most. Thresholds: hit agreement >= 0.999 (at most 9 pixels differ), SSIM >= 0.99.
+    SSIM 0.99805 (miter/curvature), 0.99961 (miter/taylor), 0.99999 (cross-cap/taylor),
+    1.0 for the other 12; one pixel of miter/taylor and of miter/curvature takes another
+    root. The two drivers round float32 differently (FMA contraction, operation order),
+    which moves a refined t by ~1e-6 and flips a pixel near a double line at most.
+    Thresholds: hit agreement >= 0.999 (at most 9 pixels differ), SSIM >= 0.99.
     """
     require_opencl()
     require_gl()

@@ -194,14 +194,14 @@ float3 shade(float3 g, float3 rd) {
     n = front ? n : -n;
     float3 color = 0.18f*base;
     {
-        float3 l = (float3)(0.4466625002869186f, 0.7444375004781977f, 0.4962916669854651f);
+        float3 l = (float3)(-0.17234958115246082f, 0.847855300448139f, 0.5014349522904914f);
         float3 h = normalize(l - rd);
         float diffuse = fmax(dot(n, l), 0.0f);
         float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);
         color += (float3)(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
-        float3 l = (float3)(-0.6115766297251506f, -0.20385887657505022f, 0.7644707871564382f);
+        float3 l = (float3)(0.9970900058559551f, -0.04450422508209698f, -0.061894217597555194f);
         float3 h = normalize(l - rd);
         float diffuse = fmax(dot(n, l), 0.0f);
         float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);

@@ -195,14 +195,14 @@ double3 shade(double3 g, double3 rd) {
     n = front ? n : -n;
     double3 color = 0.18*base;
     {
-        double3 l = (double3)(0.4466625002869186, 0.7444375004781977, 0.4962916669854651);
+        double3 l = (double3)(-0.17234958115246082, 0.847855300448139, 0.5014349522904914);
         double3 h = normalize(l - rd);
         double diffuse = fmax(dot(n, l), 0.0);
         double spec = pow(fmax(dot(n, h), 0.0), 48.0);
         color += (double3)(0.85, 0.85, 0.85)*(diffuse*base + 0.35*spec);
     }
     {
-        double3 l = (double3)(-0.6115766297251506, -0.20385887657505022, 0.7644707871564382);
+        double3 l = (double3)(0.9970900058559551, -0.04450422508209698, -0.061894217597555194);
         double3 h = normalize(l - rd);
         double diffuse = fmax(dot(n, l), 0.0);
         double spec = pow(fmax(dot(n, h), 0.0), 48.0);

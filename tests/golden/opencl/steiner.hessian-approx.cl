@@ -174,14 +174,14 @@ float3 shade(float3 g, float3 rd) {
     n = front ? n : -n;
     float3 color = 0.18f*base;
     {
-        float3 l = (float3)(0.4466625002869186f, 0.7444375004781977f, 0.4962916669854651f);
+        float3 l = (float3)(-0.17188476163102112f, 0.832612442726477f, 0.5265094006151227f);
         float3 h = normalize(l - rd);
         float diffuse = fmax(dot(n, l), 0.0f);
         float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);
         color += (float3)(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
-        float3 l = (float3)(-0.6115766297251506f, -0.20385887657505022f, 0.7644707871564382f);
+        float3 l = (float3)(0.997111254924301f, -0.07479896173655665f, -0.013200781280615852f);
         float3 h = normalize(l - rd);
         float diffuse = fmax(dot(n, l), 0.0f);
         float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);
