@@ -38,8 +38,10 @@ test: setup
 	$(PY) -m ruff check implc tests
 	$(PY) -m pytest
 
+# Rewrite every golden shader (GLSL, WGSL, OpenCL) from the current output; review the diff.
 golden: setup
-	$(PY) -m pytest tests/test_golden.py --update-golden
+	$(PY) -m pytest tests/test_golden.py tests/test_wgsl.py tests/test_opencl.py \
+	  -k "test_golden and not validates and not builds" --update-golden
 
 lint: setup
 	$(PY) -m ruff check implc tests

@@ -2,7 +2,7 @@
 and the exact reference.
 
 Goldens (tests/golden/opencl/) are byte-compared and each is built by the OpenCL driver;
-update on purpose with `pytest tests/test_opencl.py --update-golden`. Without PoCL the
+update on purpose with `pytest tests/test_opencl.py --update-golden` (or `make golden`). Without PoCL the
 tests that need it skip, and fail under CI=true.
 """
 
