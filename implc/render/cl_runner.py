@@ -14,7 +14,6 @@ signature stays the same for every backend.
 from __future__ import annotations
 
 import os
-import time
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -27,7 +26,7 @@ from ..emit import emit
 from ..errors import ToolError
 from ..methods import Constants
 from ..surface import Surface
-from .result import RenderResult
+from .result import RenderResult, TimedRunner
 from .scene import View
 
 POCL = "Portable Computing Language"
@@ -125,7 +124,7 @@ def _vector3(values, precision: str):
     return make(*(float(v) for v in values))
 
 
-class ClRunner:
+class ClRunner(TimedRunner):
     """A built program, its kernel and output buffers; `frame()` renders and reads back."""
 
     def __init__(self, source: str, view: View, width: int, height: int,
@@ -172,20 +171,8 @@ class ClRunner:
         cl.enqueue_copy(self.queue, color, self.color)
         cl.enqueue_copy(self.queue, aux, self.aux)
         self.queue.finish()
-        return RenderResult(  # row j of the buffers is image row j (top first): no flip
-            color=np.ascontiguousarray(color[..., :3]),
-            hit=aux[..., 0] > 0.5,
-            t=np.ascontiguousarray(aux[..., 1]),
-            steps=np.ascontiguousarray(aux[..., 2]),
-            residual=np.ascontiguousarray(aux[..., 3]),
-        )
-
-    def frame(self) -> RenderResult:
-        start = time.perf_counter()
-        self.draw()
-        result = self.read()
-        result.timing["frame"] = time.perf_counter() - start
-        return result
+        # row j of the buffers is image row j (top first): no flip
+        return RenderResult.from_buffers(color, aux)
 
     def release(self) -> None:
         self.color.release()

@@ -7,13 +7,12 @@ Rows are flipped on readback so row 0 is the top of the image, like every runner
 from __future__ import annotations
 
 import os
-import time
 from functools import lru_cache
 
 import numpy as np
 
 from ..errors import ToolError
-from .result import RenderResult
+from .result import RenderResult, TimedRunner
 from .scene import View
 
 TRIANGLES = 0x0004  # GL_TRIANGLES
@@ -37,7 +36,7 @@ def renderer_name() -> str:
     return str(context().info.get("GL_RENDERER", "unknown"))
 
 
-class GlRunner:
+class GlRunner(TimedRunner):
     """A compiled program and its framebuffer; `frame()` renders and reads back once."""
 
     def __init__(self, fragment: str, vertex: str, view: View, width: int, height: int):
@@ -77,20 +76,7 @@ class GlRunner:
         aux = np.frombuffer(self.fbo.read(components=4, attachment=1, dtype="f4"), np.float32)
         color = color.reshape(shape)[::-1]
         aux = aux.reshape(shape)[::-1]
-        return RenderResult(
-            color=np.ascontiguousarray(color[..., :3]),
-            hit=aux[..., 0] > 0.5,
-            t=np.ascontiguousarray(aux[..., 1]),
-            steps=np.ascontiguousarray(aux[..., 2]),
-            residual=np.ascontiguousarray(aux[..., 3]),
-        )
-
-    def frame(self) -> RenderResult:
-        start = time.perf_counter()
-        self.draw()
-        result = self.read()
-        result.timing["frame"] = time.perf_counter() - start
-        return result
+        return RenderResult.from_buffers(color, aux)
 
     def release(self) -> None:
         for obj in (self.fbo, self.color, self.aux, self.vao, self.program):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,6 +23,18 @@ class RenderResult:
     residual: np.ndarray  # float32 (H, W)
     timing: dict[str, float] = field(default_factory=dict)  # seconds, by phase
 
+    @classmethod
+    def from_buffers(cls, color: np.ndarray, aux: np.ndarray) -> RenderResult:
+        """From the (H, W, 4) float buffers every shader writes, row 0 on top:
+        colour (r, g, b, 1) and aux (hit, t, steps, |S|)."""
+        return cls(
+            color=np.ascontiguousarray(color[..., :3]),
+            hit=aux[..., 0] > 0.5,
+            t=np.ascontiguousarray(aux[..., 1]),
+            steps=np.ascontiguousarray(aux[..., 2]),
+            residual=np.ascontiguousarray(aux[..., 3]),
+        )
+
     @property
     def height(self) -> int:
         return int(self.hit.shape[0])
@@ -29,3 +42,20 @@ class RenderResult:
     @property
     def width(self) -> int:
         return int(self.hit.shape[1])
+
+
+class TimedRunner:
+    """Base of the GPU runners: `frame()` = draw, wait for completion, read back, timed."""
+
+    def draw(self) -> None:
+        raise NotImplementedError
+
+    def read(self) -> RenderResult:
+        raise NotImplementedError
+
+    def frame(self) -> RenderResult:
+        start = time.perf_counter()
+        self.draw()
+        result = self.read()
+        result.timing["frame"] = time.perf_counter() - start
+        return result

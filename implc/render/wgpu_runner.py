@@ -12,13 +12,12 @@ This module is not named `wgpu.py`: that would shadow the wgpu package.
 from __future__ import annotations
 
 import os
-import time
 from functools import lru_cache
 
 import numpy as np
 
 from ..errors import ToolError
-from .result import RenderResult
+from .result import RenderResult, TimedRunner
 from .scene import View
 
 WORKGROUP = 8  # the workgroup size (8 x 8) in templates/wgsl/program.wgsl.j2
@@ -86,7 +85,7 @@ def _uniforms(view: View, width: int, height: int) -> bytes:
     return data.tobytes()
 
 
-class WgpuRunner:
+class WgpuRunner(TimedRunner):
     """A compiled compute pipeline and its output resources; `frame()` renders once."""
 
     def __init__(self, program: str, view: View, width: int, height: int):
@@ -133,7 +132,7 @@ class WgpuRunner:
             {"binding": 2, "resource": {"buffer": self.aux}},
         ])
 
-    def dispatch(self) -> None:
+    def draw(self) -> None:
         """Record and submit one frame: the compute pass and the copies out of it."""
         encoder = self.device.create_command_encoder()
         compute = encoder.begin_compute_pass()
@@ -161,20 +160,7 @@ class WgpuRunner:
             arrays.append(raw[:, : self.width * 4].reshape(self.height, self.width, 4).copy())
             buffer.unmap()
         color, aux = arrays
-        return RenderResult(
-            color=np.ascontiguousarray(color[..., :3]),
-            hit=aux[..., 0] > 0.5,
-            t=np.ascontiguousarray(aux[..., 1]),
-            steps=np.ascontiguousarray(aux[..., 2]),
-            residual=np.ascontiguousarray(aux[..., 3]),
-        )
-
-    def frame(self) -> RenderResult:
-        start = time.perf_counter()
-        self.dispatch()
-        result = self.read()
-        result.timing["frame"] = time.perf_counter() - start
-        return result
+        return RenderResult.from_buffers(color, aux)
 
     def release(self) -> None:
         for buffer in (self.uniforms, self.aux, self.color_read, self.aux_read):
