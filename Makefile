@@ -47,8 +47,9 @@ lint: setup
 	$(PY) -m ruff check implc tests
 
 # The paper's Table 1 into results/ (docs/RESULTS.md). 1024x1024 like the paper: on this
-# 2-core llvmpipe machine one cross-cap hessian frame takes ~6 s (~40 M march steps/s) and
-# the whole run (3 surfaces x 3 configurations, 4 frames per cell) ~15 min.
+# 2-core llvmpipe machine one cross-cap hessian frame takes ~6 s (~38 M march steps/s), the
+# costliest cell (curvature at b = 0.002) ~20 s a frame, and the whole run (3 surfaces x
+# 3 configurations, 4 frames per cell) measured 7.5-11 min, within the ~20 min budget.
 BENCH_SIZE := 1024
 bench: setup
 	$(PY) -m implc bench cross-cap miter steiner --size $(BENCH_SIZE) --frames 3 -o results/

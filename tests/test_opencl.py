@@ -2,8 +2,8 @@
 and the exact reference.
 
 Goldens (tests/golden/opencl/) are byte-compared and each is built by the OpenCL driver;
-update on purpose with `pytest tests/test_opencl.py --update-golden` (or `make golden`). Without PoCL the
-tests that need it skip, and fail under CI=true.
+update on purpose with `pytest tests/test_opencl.py --update-golden` (or `make golden`).
+Without PoCL the tests that need it skip, and fail under CI=true.
 """
 
 from __future__ import annotations
