@@ -15,7 +15,8 @@ Configurations:
   hessian step), so accuracy differences come from the root test, not the step;
 - `taylor2`: hessian and hessian-approx with `taylor2 = "consistent"` (h^2/8, F''(t1) in r)
   at the paper's constants, with taylor (which has no F'' term, so is unchanged) timed
-  again beside them: a ratio is only fair between frames taken in turns, close in time.
+  again beside them: a ratio is only fair between frames taken in turns, close in time;
+- `extremum`: the same with `taylor2 = "extremum"`, implc's own test (README "The methods").
 
 Outputs in the directory: table.md, table.json, figure.png (the first configuration,
 `paper` by default, laid out like the paper's Fig. 2), figure-<config>.png for the others,
@@ -47,7 +48,7 @@ from .surface import Surface
 
 # Table 1's columns in the paper's order, then `sign` (not in the paper; informative).
 DEFAULT_METHODS: tuple[str, ...] = ("taylor", "curvature", "hessian-approx", "hessian", "sign")
-CONFIG_NAMES: tuple[str, ...] = ("paper", "equal", "taylor2")
+CONFIG_NAMES: tuple[str, ...] = ("paper", "equal", "taylor2", "extremum")
 EQUAL_STEP = 0.002  # the paper's hessian step, given to every method in `equal`
 TILE = 256  # figure tile size in pixels
 
@@ -89,6 +90,10 @@ def make_configs(names: Sequence[str], equal_step: float = EQUAL_STEP) -> list[B
             "taylor2", "Eq. 4 consistent (h^2/8, F''(t1) in r) at the paper's constants; "
             "taylor is unaffected and re-timed as the fps baseline",
             {"taylor2": "consistent"}, methods=("taylor", "hessian-approx", "hessian")),
+        "extremum": BenchConfig(
+            "extremum", "implc's extremum test (consistent Eq. 4 plus the extremum of each "
+            "end's quadratic model) at the paper's constants; taylor re-timed as the baseline",
+            {"taylor2": "extremum"}, methods=("taylor", "hessian-approx", "hessian")),
     }
     configs = []
     for name in names:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -40,12 +41,17 @@ exit codes: 0 ok, 1 bad input, 2 bad command line, 3 validation failed,
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_join_equation_values(sys.argv[1:] if argv is None else argv))
+    if getattr(args, "equation", None) == []:  # argparse drops a value that is exactly "--"
+        args.equation = "--"
     if not getattr(args, "command", None):
         parser.print_help()
         return EXIT_OK
     try:
-        return args.run(args)
+        from .derive import derive_limits
+
+        with derive_limits(getattr(args, "max_derived", None)):
+            return args.run(args)
     except ImplcError as err:
         print(err.render(), file=sys.stderr)
         return err.exit_code
@@ -59,6 +65,28 @@ def main(argv: list[str] | None = None) -> int:
         print("implc: error: too complex: expression nesting exceeds Python's limits",
               file=sys.stderr)
         return 1
+
+
+def _join_equation_values(argv: list[str]) -> list[str]:
+    """`-e "-x^2 + z"` -> `--equation=-x^2 + z`.
+
+    argparse reads a separate value that starts with '-' as an option and reports
+    "expected one argument", but equations often start with a minus sign (a quarter of
+    the MathMod rows do). A value that looks like a long option (`--help`) is left alone.
+    """
+    joined: list[str] = []
+    i = 0
+    while i < len(argv):
+        arg = argv[i]
+        value = argv[i + 1] if i + 1 < len(argv) else None
+        if (arg in ("-e", "--equation") and value is not None and value.startswith("-")
+                and not re.match(r"--[A-Za-z]", value)):
+            joined.append(f"--equation={value}")
+            i += 2
+            continue
+        joined.append(arg)
+        i += 1
+    return joined
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -135,9 +163,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="timed frames per cell after 1 warm-up; fps is their median (default 3)")
     p.add_argument("-b", "--backend", choices=[b for b in BACKENDS if b != "reference"],
                    default="gl", help="renderer to time (default gl)")
-    p.add_argument("--configs", default="paper,equal,taylor2",
+    p.add_argument("--configs", default="paper,equal,taylor2,extremum",
                    help="comma-separated: paper (Table 1 constants), equal (one step for "
-                        "all), taylor2 (Eq. 4 consistent); default all three")
+                        "all), taylor2 (Eq. 4 consistent), extremum (implc's test); "
+                        "default all four")
     p.add_argument("--equal-step", type=float, default=None,
                    help="base step of every method in the `equal` configuration (default 0.002)")
     p.add_argument("--exr", action="store_true",
@@ -145,6 +174,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="output directory (created if missing)")
     p.set_defaults(run=cmd_bench)
+
+    p = sub.add_parser("corpus", help="run implc over a corpus of equations and report",
+                       description="Load, derive, numerically check, emit (-m hessian, "
+                                   "program) and validate every row of a corpus TSV; "
+                                   "report what compiled and why the rest was rejected.")
+    p.add_argument("tsv", nargs="?", type=Path, metavar="TSV",
+                   help="corpus TSV (default: ../shared/corpus/implicit_surface_corpus.tsv)")
+    p.add_argument("-o", "--output", type=Path, help="write the Markdown report here")
+    p.add_argument("-t", "--targets", nargs="+", choices=list(TARGETS), default=list(TARGETS),
+                   help="targets to emit and validate (default: all)")
+    p.add_argument("-j", "--jobs", type=int, default=0,
+                   help="worker processes (default 0: one per CPU, at most 4)")
+    p.add_argument("--rows", help="only these data rows, e.g. 1-20,35")
+    p.add_argument("--no-validate", action="store_true", help="emit only; skip the compilers")
+    p.add_argument("--no-check", action="store_true", help="skip the numeric checks")
+    _limit_args(p)
+    p.set_defaults(run=cmd_corpus)
     return parser
 
 
@@ -153,10 +199,15 @@ def _surface_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-e", "--equation", help='equation text instead of a file, e.g. "x^2+y^2+z^2=1"')
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="set a named parameter (repeatable)")
-    limits = p.add_argument_group("limits (hostile-input guards)")
-    limits.add_argument("--max-degree", type=int, help="largest total degree (default 40)")
-    limits.add_argument("--max-exponent", type=int, help="largest integer exponent (default 64)")
-    limits.add_argument("--max-nodes", type=int, help="largest expression size (default 10000)")
+    _limit_args(p)
+
+
+def _limit_args(p: argparse.ArgumentParser) -> None:
+    limits = p.add_argument_group("limits (hostile-input guards; README \"Limits\")")
+    for flag, text in LIMIT_FLAGS.items():
+        default = getattr(_default_limits(), flag[2:].replace("-", "_"))
+        limits.add_argument(flag, type=_positive_int, metavar="N",
+                            help=f"{text} (default {default})")
 
 
 def _shader_args(p: argparse.ArgumentParser) -> None:
@@ -180,14 +231,42 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
     c.add_argument("--max-steps", type=int, help=f"march step cap per ray (default {d.max_steps})")
 
 
+# Every field of implc.parse.Limits, as the option its error messages name.
+LIMIT_FLAGS = {
+    "--max-chars": "longest equation, in characters",
+    "--max-depth": "deepest nesting of brackets and operators",
+    "--max-nodes": "largest expression size, in nodes",
+    "--max-exponent": "largest |integer exponent| of a non-constant base",
+    "--max-degree": "largest total degree in x, y, z",
+    "--max-terms": "most monomials after expansion",
+    "--max-literal-exponent": "number literals must lie within 1e-N .. 1e+N",
+    "--max-constant-digits": "most digits of an exactly computed constant",
+    "--max-derived": "largest estimated size of the derivatives before CSE, in nodes",
+}
+
+
+def _default_limits():
+    from .parse import Limits
+
+    return Limits()
+
+
+def _positive_int(text: str) -> int:
+    """argparse type of the limit options: a limit of 0 or below is a usage error."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if not 1 <= value <= 10**9:
+        raise argparse.ArgumentTypeError(f"expected an integer from 1 to 10^9, got {text}")
+    return value
+
+
 def _limits(args):
     from .parse import Limits
 
-    given = {
-        "max_degree": args.max_degree,
-        "max_exponent": args.max_exponent,
-        "max_nodes": args.max_nodes,
-    }
+    given = {flag[2:].replace("-", "_"): getattr(args, flag[2:].replace("-", "_"))
+             for flag in LIMIT_FLAGS}
     return Limits(**{k: v for k, v in given.items() if v is not None})
 
 
@@ -319,6 +398,52 @@ def cmd_bench(args) -> int:
         equal_step=EQUAL_STEP if args.equal_step is None else args.equal_step, exr=args.exr,
     )
     return EXIT_OK
+
+
+def cmd_corpus(args) -> int:
+    from . import corpus
+
+    tsv = args.tsv or corpus.default_tsv()
+    if tsv is None:
+        raise InputError("no corpus found at ../shared/corpus/implicit_surface_corpus.tsv; "
+                         "give the TSV path (tests/data/corpus_permissive.tsv is a copy of "
+                         "its permissively licensed rows)")
+    rows = corpus.load_rows(tsv)
+    if args.rows:
+        wanted = _row_numbers(args.rows)
+        rows = [r for r in rows if r.number in wanted]
+    jobs = corpus.effective_jobs(args.jobs)
+
+    def progress(result) -> None:
+        if result.outcome != corpus.COMPILED:
+            print(f"row {result.row.number} ({result.row.name}): {result.outcome}: "
+                  f"{result.reason}", file=sys.stderr)
+
+    start = time.perf_counter()
+    results = corpus.run_corpus(rows, args.targets, validate=not args.no_validate,
+                                check=not args.no_check, jobs=jobs, limits=_limits(args),
+                                progress=progress)
+    wall = time.perf_counter() - start
+    if args.output:
+        report = corpus.render_report(results, str(tsv), args.targets, wall, jobs,
+                                      validate=not args.no_validate)
+        write_atomic(args.output, report)
+        print(f"wrote {args.output}", file=sys.stderr)
+    print(corpus.summary_line(results, args.targets) + f" ({wall:.0f} s)")
+    return 3 if any(r.outcome == corpus.FAILED for r in results) else EXIT_OK
+
+
+def _row_numbers(text: str) -> set[int]:
+    """`1-20,35` -> {1, ..., 20, 35}."""
+    numbers: set[int] = set()
+    for part in text.split(","):
+        low, _, high = part.strip().partition("-")
+        try:
+            first, last = int(low), int(high or low)
+        except ValueError:
+            raise InputError(f"--rows: expected numbers like 1-20,35, got {text!r}") from None
+        numbers.update(range(first, last + 1))
+    return numbers
 
 
 def _size(args) -> tuple[int, int]:

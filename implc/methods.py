@@ -28,7 +28,9 @@ class Constants:
     tau2: float = 0.01  # |F| > tau2: far from it, step 2b
     tau3: float = 0.01  # |F'| <= tau3 near the surface: silhouette, step b/4
     eps: float = 1e-3  # finite-difference step of hessian-approx along the ray
-    taylor2: str = "paper"  # Eq. 4 as printed, or "consistent" (h^2/8 and F''(t1) for r)
+    # Eq. 4 as printed ("paper"), "consistent" (h^2/8 and F''(t1) in r), or "extremum"
+    # (consistent, plus the extremum of each end's quadratic model inside the step)
+    taylor2: str = "paper"
     max_steps: int = 20000  # cap on march steps per ray (a safety bound, not a tuning knob)
     refine_steps: int = 10  # Newton-bisection iterations on the isolated interval
 
@@ -36,7 +38,7 @@ class Constants:
         return asdict(self)
 
 
-TAYLOR2_CHOICES = ("paper", "consistent")
+TAYLOR2_CHOICES = ("paper", "consistent", "extremum")
 
 
 @dataclass(frozen=True)

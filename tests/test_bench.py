@@ -65,20 +65,21 @@ def test_bench_writes_tables_figure_and_renders(tmp_path):
                  "--methods", "taylor", "hessian", "-o", str(out))
     assert proc.returncode == 0, proc.stderr
     # progress goes to stderr, one line per cell: 2 paper + 2 equal + 2 taylor2
-    assert "[1/6] cross-cap taylor paper:" in proc.stderr
-    assert "[6/6] cross-cap hessian taylor2:" in proc.stderr
+    assert "[1/8] cross-cap taylor paper:" in proc.stderr
+    assert "[8/8] cross-cap hessian extremum:" in proc.stderr
 
     data = json.loads((out / "table.json").read_text())
     assert data["size"] == 48 and data["frames"] == 1
     assert data["machine"]["gl_renderer"] and data["machine"]["cpu_count"] >= 1
     assert data["surfaces"]["cross-cap"]["reference_seconds"] > 0
     configs = {c["name"]: c for c in data["configs"]}
-    assert list(configs) == ["paper", "equal", "taylor2"]
+    assert list(configs) == ["paper", "equal", "taylor2", "extremum"]
     assert list(configs["taylor2"]["results"]["cross-cap"]) == ["taylor", "hessian"]
     assert configs["equal"]["constants"]["taylor"]["step"] == 0.002
     assert configs["paper"]["constants"]["hessian"]["step"] == 0.002
     assert configs["paper"]["constants"]["taylor"]["step"] == 0.01
     assert configs["taylor2"]["constants"]["hessian"]["taylor2"] == "consistent"
+    assert configs["extremum"]["constants"]["hessian"]["taylor2"] == "extremum"
     pixels = 48 * 48
     for config in configs.values():
         for method, cell in config["results"]["cross-cap"].items():
@@ -99,16 +100,18 @@ def test_bench_writes_tables_figure_and_renders(tmp_path):
             cells["hessian"]["fps"] / cells["taylor"]["fps"])
 
     table = (out / "table.md").read_text()
-    for header in ("## paper:", "## equal:", "## taylor2:", "## paper Table 1 beside"):
+    for header in ("## paper:", "## equal:", "## taylor2:", "## extremum:",
+                   "## paper Table 1 beside"):
         assert header in table
-    assert table.count("| surface | taylor | hessian |") == 4
-    assert table.count("| cross-cap | ") == 4  # three configurations + the paper comparison
+    assert table.count("| surface | taylor | hessian |") == 5
+    assert table.count("| cross-cap | ") == 5  # four configurations + the paper comparison
     assert "(1.00) / " in table  # taylor's ratio cell
 
     with Image.open(out / "figure.png") as figure:
         assert figure.format == "PNG"
         assert figure.width >= 3 * 48 and figure.height >= 48  # taylor, hessian, reference
-    assert (out / "figure-equal.png").is_file() and (out / "figure-taylor2.png").is_file()
+    for config in ("equal", "taylor2", "extremum"):
+        assert (out / f"figure-{config}.png").is_file()
     assert (out / "renders" / "cross-cap-reference.png").is_file()
     assert (out / "renders" / "cross-cap-hessian-taylor2.json").is_file()
     assert not list(out.rglob(".*"))  # no temporary files left behind
