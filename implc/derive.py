@@ -9,11 +9,114 @@ step) can supply the same named quantities later; methods only name what they ne
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from functools import cached_property
 
 import sympy
 
+from .errors import LimitError
+from .parse import Limits
 from .symbols import DIRECTION, POINT
+
+# Resource bound (README "Limits"): the estimated size, in expression-tree nodes, of every
+# quantity a marcher may ask for (S, the gradient, F', F'' and the Laplacian) before CSE.
+# sympy's differentiation and `cse` take time roughly proportional to it (about 20-50 us
+# a node here); the largest corpus row (a degree-18 torus knot) estimates ~340,000.
+DEFAULT_MAX_DERIVED = Limits().max_derived
+_MAX_DERIVED: ContextVar[int] = ContextVar("implc_max_derived", default=DEFAULT_MAX_DERIVED)
+_CAP = 10**15  # estimates saturate here, so hostile input cannot build huge integers
+
+
+@contextmanager
+def derive_limits(max_derived: int | None) -> Iterator[None]:
+    """Set the derived-size bound for everything derived inside the block (the CLI's
+    `--max-derived`); None keeps the current one."""
+    if max_derived is None:
+        yield
+        return
+    token = _MAX_DERIVED.set(max_derived)
+    try:
+        yield
+    finally:
+        _MAX_DERIVED.reset(token)
+
+
+def current_max_derived() -> int:
+    """The bound `Derivatives` checks against (part of emit's cache key)."""
+    return _MAX_DERIVED.get()
+
+
+def estimate_derived_size(expr: sympy.Expr) -> int:
+    """Estimated tree size of S, its gradient, F', F'' and the Laplacian, before CSE.
+
+    Cheap (one pass over the distinct sub-expressions, iterative, no differentiation), so
+    it runs before sympy is asked to differentiate anything. Per node it tracks (s, d1,
+    d2): tree size and the sizes of a first and a second partial derivative by the
+    product and chain rules, with no credit for sharing; nested compositions grow like
+    depth^3 here exactly as they do in sympy (`sin(sin(...(xyz)))`, 40 deep: ~640,000).
+    """
+    point = set(POINT)
+    memo: dict[sympy.Basic, tuple[int, int, int]] = {}
+    stack: list[tuple[sympy.Basic, bool]] = [(expr, False)]
+    while stack:
+        node, ready = stack.pop()
+        if node in memo:
+            continue
+        if not ready and node.args:
+            stack.append((node, True))
+            stack.extend((a, False) for a in node.args if a not in memo)
+            continue
+        memo[node] = _node_estimate(node, [memo[a] for a in node.args], point)
+    s, d1, d2 = memo[expr]
+    return min(_CAP, s + 4 * d1 + 7 * d2)
+
+
+def _node_estimate(node, parts: list[tuple[int, int, int]], point) -> tuple[int, int, int]:
+    """(s, d1, d2) of `node` from those of its arguments (see estimate_derived_size)."""
+    s = min(_CAP, 1 + sum(p[0] for p in parts))
+    if not parts or not node.free_symbols & point:
+        return s, 1, 1
+    if node.is_Add:
+        d1 = 1 + sum(p[1] for p in parts)
+        d2 = 1 + sum(p[2] for p in parts)
+    elif node.is_Mul:  # (fg)' = f'g + fg'; (fg)'' = f''g + 2f'g' + fg''
+        varying = [p for a, p in zip(node.args, parts, strict=True) if a.free_symbols & point]
+        k = len(varying)
+        d1 = sum(p[1] for p in varying) + k * s
+        d2 = sum(p[2] + k * p[1] for p in varying) + (k + k * k) * s
+    elif node.is_Pow:  # b^e: e b^(e-1) b' (+ log b terms for a varying exponent)
+        d1 = sum(p[1] for p in parts) + 2 * s + 3
+        d2 = sum(p[2] + 2 * p[1] for p in parts) + 4 * s + 6
+    else:  # f(u): f'(u) u'; f''(u) u'^2 + f'(u) u''
+        d1 = sum(p[1] + 3 * p[0] for p in parts) + 3
+        d2 = sum(p[2] + 2 * p[1] + 6 * p[0] for p in parts) + 6
+    return s, min(_CAP, d1), min(_CAP, d2)
+
+
+def check_derived_size(expr: sympy.Expr, max_derived: int | None = None) -> int:
+    """Raise `LimitError` ("too complex: ...") when `expr`'s derivatives would be too big.
+
+    Returns the estimate. Runs before any differentiation, so a compile that would run
+    for minutes (or exhaust memory or Python's recursion limit inside sympy) stops at once.
+    """
+    limit = current_max_derived() if max_derived is None else max_derived
+    size = estimate_derived_size(expr)
+    if size > limit:
+        raise LimitError(
+            f"too complex: derivatives would have about {_approx(size)} nodes, exceeding the "
+            f"limit of {limit} (--max-derived)"
+        )
+    return size
+
+
+def _approx(n: int) -> str:
+    """2 significant digits, so the message stays readable and stable: 1,300,000."""
+    if n < 100:
+        return str(n)
+    digits = len(str(n)) - 2
+    return f"{round(n, -digits):,}"
 
 # Quantity names methods may ask for, and what each means.
 QUANTITIES = {
@@ -28,17 +131,18 @@ QUANTITIES = {
 class Derivatives:
     """All derived quantities of one surface function, each computed at most once."""
 
-    def __init__(self, expr: sympy.Expr):
+    def __init__(self, expr: sympy.Expr, max_derived: int | None = None):
+        check_derived_size(expr, max_derived)
         self.expr = expr
 
     @cached_property
     def gradient(self) -> tuple[sympy.Expr, ...]:
-        return tuple(sympy.diff(self.expr, v) for v in POINT)
+        return tuple(branch_diff(self.expr, v) for v in POINT)
 
     @cached_property
     def hessian(self) -> tuple[tuple[sympy.Expr, ...], ...]:
         g = self.gradient
-        return tuple(tuple(sympy.diff(g[i], POINT[j]) for j in range(3)) for i in range(3))
+        return tuple(tuple(branch_diff(g[i], POINT[j]) for j in range(3)) for i in range(3))
 
     @cached_property
     def laplacian(self) -> sympy.Expr:
@@ -66,6 +170,35 @@ class Derivatives:
         if name == "lap":
             return (self.laplacian,)
         raise KeyError(f"unknown quantity {name!r}; known: {', '.join(QUANTITIES)}")
+
+
+class _BranchAbs(sympy.Function):
+    """|u| with the derivative sign(u) u' for every u (README: abs by branch)."""
+
+    def fdiff(self, argindex=1):
+        return _BranchSign(self.args[0])
+
+
+class _BranchSign(sympy.Function):
+    """sign(u) with sympy's derivative for real u, 2 delta(u) u' (printed as 0)."""
+
+    def fdiff(self, argindex=1):
+        return 2 * sympy.DiracDelta(self.args[0])
+
+
+def branch_diff(expr: sympy.Expr, var: sympy.Symbol) -> sympy.Expr:
+    """d expr / d var with abs and sign differentiated by branch whatever their argument.
+
+    sympy does so only when it can prove the argument real. It cannot for acos(x),
+    log(x) or sqrt(x) (complex outside their domain), and then returns re/im/arg terms
+    or an unevaluated Derivative that no target can print (found by tests/test_fuzz.py:
+    `acos(x)^(1/3)`). For real arguments the result is exactly sympy's.
+    """
+    if not expr.has(sympy.Abs, sympy.sign):
+        return sympy.diff(expr, var)
+    branched = expr.replace(sympy.Abs, _BranchAbs).replace(sympy.sign, _BranchSign)
+    derived = sympy.diff(branched, var)
+    return derived.replace(_BranchAbs, sympy.Abs).replace(_BranchSign, sympy.sign)
 
 
 def polynomial_degree(expr: sympy.Expr) -> int | None:

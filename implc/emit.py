@@ -14,7 +14,7 @@ import jinja2
 import sympy
 
 from .backends import get_target
-from .derive import Derivatives
+from .derive import Derivatives, current_max_derived
 from .errors import InputError
 from .methods import Constants, Method, get_method
 from .optimize import Program, optimize
@@ -51,14 +51,18 @@ def environment() -> jinja2.Environment:
 
 
 def build_functions(expr: sympy.Expr, method: Method) -> dict[str, Program]:
-    """Derive and optimize every function the method needs (jointly CSE'd per function)."""
-    return dict(_build_functions(expr, method.name))
+    """Derive and optimize every function the method needs (jointly CSE'd per function).
+
+    Raises `LimitError` first when the derivatives would exceed `--max-derived`."""
+    return dict(_build_functions(expr, method.name, current_max_derived()))
 
 
 @lru_cache(maxsize=32)
-def _build_functions(expr: sympy.Expr, method_name: str) -> tuple[tuple[str, Program], ...]:
+def _build_functions(
+    expr: sympy.Expr, method_name: str, max_derived: int
+) -> tuple[tuple[str, Program], ...]:
     method = get_method(method_name)
-    derivatives = Derivatives(expr)
+    derivatives = Derivatives(expr, max_derived)
     programs: dict[str, Program] = {}
     for name, quantities in method.all_functions().items():
         outputs = [e for q in quantities for e in derivatives.quantity(q)]

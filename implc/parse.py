@@ -13,8 +13,9 @@ The language (DESIGN.md section 3):
 - numbers `2`, `0.5`, `.5`, `1e-3`, `2E+4`, read exactly (`0.1` is 1/10). A number followed
   by `e` and digits is scientific notation (`2e-3` is 0.002); otherwise `e` is the
   constant (`2e` is 2*e, `2e+x` is 2*e + x);
-- variables `x y z`; constants `pi`, `e`; named parameters (substituted by their values);
-  function calls `name(arg, ...)` from the function table, with its arity;
+- variables `x y z`; constants `pi` (also spelled `PI`), `e`; named parameters
+  (substituted by their values); function calls `name(arg, ...)` from the function
+  table, with its arity;
 - `+ - * /`; powers `^` and `**`, right-associative and binding tighter than a unary
   sign (`-x^2` is `-(x^2)`, `2^3^2` is 512, `2^-1` is 1/2); `(...)` and `[...]`;
 - implicit multiplication, binding like `*`: `4x^2(x+1)`, `x^2y^2`, `(x+1)(x-1)`,
@@ -32,8 +33,8 @@ Semantics:
   `|b|^(p/q)` for even p. Other non-integer exponents (`x^0.5`, `x^pi`) are an ordinary
   power, defined for b >= 0 only (like `pow` in GLSL). A negative rational base needs an
   integer exponent or a fraction with an odd denominator.
-- Exponents of expressions that depend on x, y, z must be constant; a constant base may
-  have a variable exponent (`2^x`, `e^(-x^2)`).
+- Exponents of expressions that depend on x, y, z must be constant; a positive constant
+  base may have a variable exponent (`2^x`, `e^(-x^2)`; not `0^x` or `(1-pi)^x`).
 - Division by a constant zero is an error, and so is any sub-expression that sympy
   evaluates to a non-real, infinite or undefined value (`sqrt(-1)`, `log(0)`, `asin(2)`,
   `sqrt(-x^2)`). Constants sympy leaves unevaluated (`sqrt(1 - pi)`) are not evaluated
@@ -53,6 +54,7 @@ from __future__ import annotations
 import difflib
 import math
 import re
+import unicodedata
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -87,8 +89,12 @@ class Limits:
     # float32 shaders cannot represent values far outside this range meaningfully.
     max_literal_exponent: int = 30
     # Decimal digits of the numerator or denominator of any rational constant computed
-    # exactly while parsing (literals, folded constants such as 2^100 or 9^9^9).
+    # exactly while parsing (literals, folded constants such as 2^100 or 9^9^9); a root
+    # of rational constants, r^(p/q), needs q x digits(r) <= 10 x this.
     max_constant_digits: int = 300
+    # Estimated size (tree nodes) of the derivatives a marcher needs, before CSE; checked
+    # by implc.derive before differentiating (derivation and CSE time grow with it).
+    max_derived: int = 500_000
 
 
 _WHITESPACE = " \t\n\r"
@@ -160,10 +166,18 @@ _FUNCTION_ALIASES: dict[str, str] = {
 }
 _POWER_FUNCTIONS = ("pow", "power", "powf")
 
+# Other spellings of the constants that real dialects use and that mean nothing else:
+# surf and SURFER write `PI` (corpus: IMAGINARY/surfer-alggeo-gtk). Not `E`: it is a
+# common parameter name. A parameter may not take an alias's name.
+_CONSTANT_ALIASES: dict[str, str] = {"PI": "pi"}
+
 # sympy classes that compare all their arguments pairwise when evaluated (see docstring).
 _UNEVALUATED = frozenset({"Min", "Max"})
 
 _LOG10_2 = 30103  # log10(2) * 10^5, for exact integer comparisons of digit counts
+_RADICAL_CAP = 10**12  # root degrees saturate here (see _Analyzer.check_radicals)
+_ROOT_FUNCTIONS = {"sqrt": 2, "cbrt": 3}  # table functions that take a root of their argument
+_GROWING = frozenset({"exp", "sinh", "cosh"})  # |f(a)| is about e^|a|: checked when constant
 _NON_REAL_MESSAGES: tuple[tuple[sympy.Basic, str], ...] = (
     (sympy.nan, "value is undefined"),
     (sympy.zoo, "value is infinite"),
@@ -203,7 +217,7 @@ def parse_equation(
         tokens = _tokenize(text, values)
         root = _Parser(source, tokens, values, limits).parse()
         info = _Analyzer(source, values, limits).analyze(root)
-        return _Builder(source, values, info).build(root)
+        return _Builder(source, values, info, limits).build(root)
     except RecursionError:
         raise LimitError(
             f"too complex: nesting is too deep to parse with the limit of {limits.max_depth} "
@@ -281,17 +295,23 @@ def check_param_name(name: str, source: Source | None = None) -> None:
         )
     if name in USER_FUNCTIONS:
         raise InputError(f"parameter name '{name}' shadows the function {name}", source, 0, length)
-    if name in CONSTANTS:
-        raise InputError(f"parameter name '{name}' shadows the constant {name}", source, 0, length)
+    if name in CONSTANTS or name in _CONSTANT_ALIASES:
+        constant = _CONSTANT_ALIASES.get(name, name)
+        raise InputError(
+            f"parameter name '{name}' shadows the constant {constant}", source, 0, length
+        )
 
 
 # --------------------------------------------------------------------------- helpers
 
 
 def _quote(text: str, width: int = 24) -> str:
-    """`'text'` for a message, shortened so a huge token cannot flood the terminal."""
+    """`'text'` for a message, shortened so a huge token cannot flood the terminal, with
+    control characters escaped (U+0000 as a backslash-u escape) so none reaches the
+    terminal raw."""
     if len(text) > width:
         text = text[: width - 3] + "..."
+    text = "".join(ch if ch.isprintable() else f"\\u{ord(ch):04x}" for ch in text)
     return f"'{text}'"
 
 
@@ -467,6 +487,8 @@ def _bad_character_message(ch: str) -> str:
     if not ch.isprintable() or ch.isspace():
         hint = "; use a plain space" if ch.isspace() else ""
         return f"unexpected character {code}{hint}"
+    if unicodedata.category(ch).startswith("M"):  # shown alone it would sit on the quote
+        return f"unexpected combining character {code}"
     hint = f"; did you mean '{_LOOKALIKES[ch]}'?" if ch in _LOOKALIKES else ""
     return f"unexpected character '{ch}' ({code}){hint}"
 
@@ -777,10 +799,14 @@ class _Parser:
         word = token.text
         if word in self.params or word in CONSTANTS:
             return self.new(_Named(token.start, token.end, word, word in self.params))
+        if word in _CONSTANT_ALIASES:
+            return self.new(_Named(token.start, token.end, _CONSTANT_ALIASES[word], False))
         followed_by_call = self.peek().is_op("(")
         if word in USER_FUNCTIONS:
             if followed_by_call:
                 return self.call(token)
+            if self.peek().kind == "bad":  # `sin（x）`: the look-alike bracket is the problem
+                raise self.error_at(self.peek().message, self.peek())
             raise self.error_at(f"function '{word}' needs arguments in parentheses", token)
         raise self.error_at(_unknown_name_message(word, followed_by_call, self.params), token)
 
@@ -884,11 +910,60 @@ class _Analyzer:
 
     def analyze(self, root: _Node) -> dict[_Node, _Info]:
         info: dict[_Node, _Info] = {}
+        radicals: dict[_Node, tuple[int, int]] = {}
         for node in _postorder(root):
             result = self.visit(node, info)
             self.check_growth(node, result)
             info[node] = result
+            radicals[node] = self.check_radicals(node, info, radicals)
         return info
+
+    def check_radicals(
+        self,
+        node: _Node,
+        info: Mapping[_Node, _Info],
+        radicals: Mapping[_Node, tuple[int, int]],
+    ) -> tuple[int, int]:
+        """(root, digits) of `node`: the root degree under which sympy may combine
+        rational constants in it (`(4/10^21)^(1/10^4)`, `(2^(1/64))^(1/64)`,
+        `sqrt(r^(1/q))`, `(2x)^(1/q)` = 2^(1/q) |x|^(1/q)), and the most digits of a
+        rational constant that would take part.
+
+        sympy evaluates a rational to a rational power by factoring and builds integers
+        of about root x digits decimal digits: 10^4 x 22 hangs or fails (Python refuses to
+        print integers over 4300 digits; found by tests/test_fuzz.py). So root x digits
+        is bounded by ten times `max_constant_digits`. Only products, powers and roots
+        combine; a sum, or a function other than sqrt and cbrt, keeps its parts apart.
+        """
+        parts = [radicals[c] for c in _children(node)]
+        value = info[node].value
+        if value is not None:
+            if value in (0, 1, -1):
+                return 1, 0
+            bits = max(abs(value.numerator).bit_length(), value.denominator.bit_length())
+            return 1, bits * _LOG10_2 // 100_000 + 1
+        if isinstance(node, _Neg):
+            return parts[0]
+        if isinstance(node, _Product):
+            root, digits = 1, 0
+            for r, d in parts:
+                root, digits = min(math.lcm(root, r), _RADICAL_CAP), max(digits, d)
+        elif isinstance(node, _Power):  # the exponent's own radicals were checked at its nodes
+            root, digits = radicals[node.base]
+            power = info[node.exponent].value
+            if digits and power is not None and power.denominator != 1:
+                root = min(root * power.denominator, _RADICAL_CAP)
+        elif isinstance(node, _Call) and node.name in _ROOT_FUNCTIONS:
+            root, digits = parts[0]
+            if digits:
+                root = min(root * _ROOT_FUNCTIONS[node.name], _RADICAL_CAP)
+        else:  # atoms, sums and other calls: nothing combines across them
+            return 1, 0
+        if root > 1 and digits and root * digits > 10 * self.limits.max_constant_digits:
+            raise _constant_digits_error(
+                "root of a constant", self.limits, self.source, node.start, node.end - node.start
+            )
+        return root, digits
 
     def fail(self, message: str, node: _Node) -> InputError:
         return InputError(message, self.source, node.start, node.end - node.start)
@@ -1079,10 +1154,13 @@ class _Builder:
         source: Source,
         params: Mapping[str, tuple[sympy.Expr, Fraction | None]],
         info: Mapping[_Node, _Info],
+        limits: Limits = Limits(),  # noqa: B008 - frozen, so a shared default is safe
     ):
         self.source = source
         self.params = params
         self.info = info
+        self.limits = limits
+        self.analyzer = _Analyzer(source, params, limits)
 
     def fail(self, message: str, node: _Node) -> InputError:
         return InputError(message, self.source, node.start, node.end - node.start)
@@ -1092,6 +1170,11 @@ class _Builder:
         order = _postorder(root)
         for node in order:
             built[node] = self.make(node, built)
+            info = self.info[node]
+            if info.constant and info.value is None and built[node].is_Rational:
+                # sympy found an exact value the analysis could not (abs(7e23), sin(0),
+                # exp(2 log 3)): bound it like every other exact constant
+                self.analyzer.checked_value(Fraction(built[node].p, built[node].q), node)
         result = built[root]
         if result.has(*(atom for atom, _ in _NON_REAL_MESSAGES)):
             raise self.locate_non_real(order, built)
@@ -1146,8 +1229,22 @@ class _Builder:
     def make_power(self, node: _Power, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
         base = built[node.base]
         power = self.info[node.exponent].value
+        exponent = built[node.exponent]
+        if power is None and exponent.is_Rational:  # sympy evaluated it (2^abs(7e23))
+            power = Fraction(exponent.p, exponent.q)
+            self.check_late_power(node, base, power)
         if power is None:
-            return sympy.Pow(base, built[node.exponent])
+            if self.info[node.base].constant and not self.info[node.exponent].constant:
+                # b^x = exp(x log b): its derivatives need log b, so b must be positive
+                # (`0^x` and `(1-pi)^x` reached the printer as nan; found by test_fuzz.py)
+                approx = base.evalf(15)
+                if not (approx.is_real and approx.is_positive):
+                    raise self.fail("the base of a variable exponent must be positive", node)
+            if self.info[node.base].constant and self.info[node.exponent].constant:
+                self.check_magnitude(
+                    node, exponent * sympy.log(sympy.Abs(base)), "constant power"
+                )
+            return sympy.Pow(base, exponent)
         if power.denominator == 1:
             return sympy.Pow(base, sympy.Integer(power.numerator))
         exponent = sympy.Rational(power.numerator, power.denominator)
@@ -1156,16 +1253,60 @@ class _Builder:
         magnitude = sympy.Pow(sympy.Abs(base), exponent)
         return sympy.sign(base) * magnitude if power.numerator % 2 else magnitude
 
+    def check_late_power(self, node: _Power, base: sympy.Expr, power: Fraction) -> None:
+        """The limits of `_Analyzer.visit_power` for an exponent only sympy could evaluate
+        (`x^(sin(pi) + 1000)`, `2^abs(7e23)`), before sympy computes the power."""
+        if base.is_Rational:
+            self.analyzer.fold_power(node, Fraction(base.p, base.q), power, 0)
+            if power.denominator != 1:
+                bits = max(abs(base.p).bit_length(), base.q.bit_length())
+                digits = bits * _LOG10_2 // 100_000 + 1
+                if power.denominator * digits > 10 * self.limits.max_constant_digits:
+                    raise _constant_digits_error(
+                        "root of a constant", self.limits, self.source, node.start,
+                        node.end - node.start,
+                    )
+            return
+        if abs(power) > self.limits.max_exponent:
+            raise self.analyzer.limit(
+                f"exponent {_show(power)} exceeds the limit of {self.limits.max_exponent} "
+                f"(--max-exponent)",
+                node.exponent,
+            )
+        degree = abs(power.numerator) * self.info[node.base].degree
+        if power.denominator == 1 and degree > self.limits.max_degree:
+            raise self.analyzer.limit(
+                f"degree {degree} exceeds the limit of {self.limits.max_degree} (--max-degree)",
+                node,
+            )
+
+    def check_magnitude(self, node: _Node, log_value: sympy.Expr, what: str) -> None:
+        """Refuse a constant whose natural log is `log_value` when it has more than
+        `max_constant_digits` digits: sympy may compute it exactly (`e^(1e20 log 2)`
+        becomes 2^(10^20)). The estimate is numeric and cheap."""
+        try:
+            estimate = abs(complex(log_value.evalf(15)))
+        except (TypeError, ValueError):  # not a plain number (nan, zoo): found later
+            return
+        if estimate / math.log(10) > self.limits.max_constant_digits:
+            raise _constant_digits_error(
+                what, self.limits, self.source, node.start, node.end - node.start
+            )
+
     def make_call(self, node: _Call, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
         function = USER_FUNCTIONS[node.name]
         args = [built[a] for a in node.args]
+        if node.name in _GROWING and self.info[node.args[0]].constant:
+            self.check_magnitude(node, args[0], "constant value")  # exp(k log r) is r^k
         if function.sympy_name in _UNEVALUATED:
             expr = function.build(*args, evaluate=False)
         else:
             expr = function.build(*args)
-        if all(self.info[a].value is not None for a in node.args):
-            # Rational arguments keep evalf cheap; it finds e.g. asin(2), which sympy
-            # leaves unevaluated although it is not real.
+        if all(self.info[a].constant for a in node.args):
+            # Constant arguments are bounded (every check above ran on them), so evalf is
+            # cheap; it finds asin(2) or acos(pi), which sympy leaves unevaluated although
+            # they are not real (found by tests/test_fuzz.py: `acos(pi) x` reached the
+            # printer).
             approx = expr.evalf(15)
             if approx.has(sympy.nan):
                 raise self.fail("value is undefined", node)

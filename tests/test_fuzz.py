@@ -1,0 +1,427 @@
+"""Fuzzing the front end and the whole compile path.
+
+Two generators feed the same properties:
+
+- grammar-based: hypothesis strategies that write equations the way people do (numbers
+  in every notation, x y z, parameters, constants, every user function with its arity
+  and sometimes a wrong one, `+ - * / ^ **`, implicit products such as `2x`, `x y`,
+  `(x+1)(y-1)`, `( )` and `[ ]`, signs, `=`);
+- mutation-based: corpus equations, malformed.txt and hostile.txt inputs with bytes,
+  characters and tokens inserted, deleted, replaced, duplicated and spliced.
+
+Properties, each under a per-case timer (a hang fails the case):
+
+1. the parser raises `InputError` (located, rendered without error) or returns a sympy
+   expression in x, y, z and nothing else; its printed form (`Surface.equation`, the
+   shader header) parses back to the same function;
+2. the whole path (parse -> derive -> optimize -> emit GLSL) gives a shader or an
+   `ImplcError`, nothing else;
+3. every shader of a random sample validates with glslangValidator.
+
+`make test` runs a short derandomized pass (about 1,100 cases, ~40 s); `make fuzz` sets
+IMPLC_FUZZ_SCALE (see the Makefile) for 100,000+ cases with a fresh seed each run. A
+summary of case counts goes to the terminal at the end (`-s` shows it under pytest -q).
+Findings are pinned in test_fuzz_regressions below or in tests/data/malformed.txt.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import re
+import signal
+import time
+from collections import Counter
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from implc.errors import ImplcError, InputError, Source
+from implc.functions import USER_FUNCTIONS
+from implc.parse import Limits, parse_equation
+from implc.symbols import X, Y, Z
+
+DATA = Path(__file__).parent / "data"
+SCALE = float(os.environ.get("IMPLC_FUZZ_SCALE", "1"))
+LONG = SCALE > 1
+PARAMS = {"a": sympy.Rational(3, 4), "b": sympy.Rational(-5, 2), "phi": sympy.Rational(
+    1618033988749895, 10**15), "R": sympy.Integer(2)}
+PARSE_SECONDS = 5.0  # per parser case
+PATH_SECONDS = 30.0  # per whole-path case (derive + CSE + print)
+PATH_MAX_DERIVED = 60_000  # keeps a whole-path case well under a second or two
+STATS: Counter = Counter()
+
+
+def examples(short: int) -> int:
+    return int(short * SCALE)
+
+
+def profile(short: int):
+    """Settings of one fuzz test: `short` cases in make test, SCALE times more in make fuzz."""
+    return settings(
+        max_examples=examples(short),
+        deadline=None,  # the per-case timer below is the bound; hypothesis' deadline is noisy
+        derandomize=not LONG,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+        print_blob=True,
+    )
+
+
+class Hang(BaseException):
+    """A case ran past its time bound (BaseException: nothing under test may swallow it)."""
+
+
+@contextmanager
+def time_limit(seconds: float, what: str):
+    def alarm(signum, frame):
+        raise Hang(f"{what} took longer than {seconds} s")
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+# --------------------------------------------------------------------------- grammar
+
+
+def _number() -> st.SearchStrategy[str]:
+    digits = st.text("0123456789", min_size=1, max_size=4)
+    return st.one_of(
+        st.integers(0, 99).map(str),
+        st.tuples(digits, digits).map(lambda t: f"{t[0]}.{t[1]}"),
+        digits.map(lambda d: f".{d}"),
+        st.tuples(st.integers(1, 9), st.sampled_from("eE"), st.sampled_from(["", "+", "-"]),
+                  st.integers(0, 40)).map(lambda t: f"{t[0]}{t[1]}{t[2]}{t[3]}"),
+        st.sampled_from(["0", "1", "2", "0.5", "1e-3", "2E+4", "1e30", "1e-30", "3.0"]),
+    )
+
+
+VARIABLES = st.sampled_from(["x", "y", "z"])
+ATOMS = st.one_of(
+    VARIABLES, VARIABLES, VARIABLES,  # weighted: most equations should depend on x, y, z
+    st.sampled_from(["xy", "xyz", "zx", "yy", "xz"]),  # words of x, y, z: products
+    st.sampled_from(["a", "b", "phi", "R", "pi", "e", "PI"]),
+    _number(),
+)
+SPACE = st.sampled_from(["", "", "", " ", "  "])
+FUNCTIONS = sorted(USER_FUNCTIONS)
+
+
+def _juxtapose(parts: tuple[str, str, str]) -> str:
+    """An implicit product as people write one: `2x`, `x y`, `xy`, `(x+1)(x-1)`, `2 (x)`.
+
+    A number on the right needs brackets (`x 2` is an error by design); two words are
+    glued only when both are made of x, y, z (`x` `y` -> `xy`), else spaced (`a x`)."""
+    left, glue, right = parts
+    if right[:1].isdigit() or right[:1] == ".":
+        right = f"({right})"
+    word = re.compile(r"[A-Za-z_0-9]")
+    if word.match(left[-1:]) and word.match(right[:1]):
+        tail = re.search(r"[A-Za-z_0-9.]*$", left).group()
+        head = re.match(r"[A-Za-z_0-9]*", right).group()
+        if not (set(tail) <= set("xyz") and set(head) <= set("xyz")):
+            glue = " "
+    return f"{left}{glue}{right}"
+
+
+def _extend(inner: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
+    binary = st.tuples(inner, SPACE, st.sampled_from(["+", "-", "*", "/", "^", "**", "+", "*"]),
+                       SPACE, inner).map(lambda t: "".join(t))
+    implicit = st.tuples(inner, st.sampled_from(["", " "]), inner).map(_juxtapose)
+    power = st.tuples(inner, st.sampled_from(["^", "**"]), st.one_of(
+        st.integers(-4, 12).map(lambda n: f"({n})" if n < 0 else str(n)),
+        st.sampled_from(["(1/3)", "(2/3)", "0.5", "(-1/3)", "(1/2)", "x", "2"]),
+        inner)).map(lambda t: "".join(t))
+    group = st.tuples(st.sampled_from(["()", "[]", "()"]), inner).map(
+        lambda t: f"{t[0][0]}{t[1]}{t[0][1]}")
+    sign = st.tuples(st.sampled_from(["-", "+", "-"]), inner).map(lambda t: "".join(t))
+
+    @st.composite
+    def call(draw) -> str:
+        name = draw(st.sampled_from(FUNCTIONS))
+        arity = USER_FUNCTIONS[name].arity
+        if draw(st.integers(0, 19)) == 0:
+            arity = draw(st.integers(0, 3))  # a wrong arity now and then
+        args = [draw(inner) for _ in range(arity)]
+        return f"{name}({', '.join(args)})"
+
+    return st.one_of(binary, implicit, power, group, sign, call())
+
+
+EXPRESSIONS = st.tuples(st.recursive(ATOMS, _extend, max_leaves=24), VARIABLES,
+                        st.integers(0, 19)).map(
+    # most random trees are constant; add a variable to 19 of 20 of those
+    lambda t: t[0] if re.search("[xyz]", t[0]) or t[2] == 0 else f"{t[0]} + {t[1]}")
+EQUATIONS = st.one_of(
+    EXPRESSIONS,
+    st.tuples(EXPRESSIONS, SPACE, SPACE, st.one_of(_number(), EXPRESSIONS))
+    .filter(lambda t: t[0] != t[3])
+    .map(lambda t: f"{t[0]}{t[1]}={t[2]}{t[3]}"),
+)
+
+
+# --------------------------------------------------------------------------- mutation
+
+
+def _seeds() -> list[str]:
+    """Corpus equations (the permissive copy), malformed.txt and short hostile.txt inputs."""
+    import csv
+
+    seeds: list[str] = []
+    with (DATA / "corpus_permissive.tsv").open(encoding="utf-8") as handle:
+        seeds += [row["equation"] for row in csv.DictReader(handle, delimiter="\t")]
+    for line in (DATA / "malformed.txt").read_text(encoding="utf-8").splitlines():
+        if line.startswith("input: "):
+            seeds.append(line[len("input: "):])
+    for line in (DATA / "hostile.txt").read_text(encoding="utf-8").splitlines():
+        if line.startswith("-e: ") and "\\*" not in line:
+            seeds.append(line[len("-e: "):])
+    return seeds
+
+
+SEEDS = _seeds()
+ALPHABET = list("xyz0123456789.eE+-*/^()[],= abcpiqsnt_") + [
+    "**", "sin(", "sqrt(", "max(", "^-", "1e308", "0.0", "/0", "\0", "\t", "\n", "\u2212",
+    "\u00b2", "\u0445", "\ufeff", "PI", "xyz", "((", "))", "^2^2^2", "9^9", "e^", "=0",
+]
+TOKEN = re.compile(r"\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+|[A-Za-z_]\w*|\*\*|\S")
+
+
+@st.composite
+def mutants(draw) -> str:
+    text = draw(st.sampled_from(SEEDS))
+    if draw(st.booleans()):
+        other = draw(st.sampled_from(SEEDS))  # splice two seeds
+        cut_a = draw(st.integers(0, len(text)))
+        cut_b = draw(st.integers(0, len(other)))
+        text = text[:cut_a] + other[cut_b:]
+    for _ in range(draw(st.integers(1, 6))):
+        kind = draw(st.integers(0, 6))
+        pos = draw(st.integers(0, len(text)))
+        if kind == 0:  # insert a character or a fragment
+            text = text[:pos] + draw(st.sampled_from(ALPHABET)) + text[pos:]
+        elif kind == 1 and text:  # delete a run of characters
+            text = text[:pos] + text[pos + draw(st.integers(1, 4)):]
+        elif kind == 2 and text:  # replace one character by any code point
+            char = chr(draw(st.integers(0, 0x10FFFF).filter(lambda c: not 0xD800 <= c < 0xE000)))
+            text = text[:pos] + char + text[pos + 1:]
+        elif kind in (3, 4, 5):  # token level: duplicate, delete or swap tokens
+            tokens = TOKEN.findall(text)
+            if len(tokens) >= 2:
+                i = draw(st.integers(0, len(tokens) - 1))
+                j = draw(st.integers(0, len(tokens) - 1))
+                if kind == 3:
+                    tokens.insert(i, tokens[j])
+                elif kind == 4:
+                    del tokens[i]
+                else:
+                    tokens[i], tokens[j] = tokens[j], tokens[i]
+                glue = draw(st.sampled_from(["", " "]))
+                text = glue.join(tokens)
+        else:  # flip one byte of the UTF-8 encoding
+            data = bytearray(text.encode("utf-8"))
+            if data:
+                k = min(pos, len(data) - 1)
+                data[k] ^= 1 << draw(st.integers(0, 7))
+            text = data.decode("utf-8", "replace")
+    return text
+
+
+# --------------------------------------------------------------------------- properties
+
+
+def check_parse(text: str) -> sympy.Expr | None:
+    """Property 1 on one input; returns the expression when it parses."""
+    STATS["parser"] += 1
+    source = Source("<equation>", text)
+    try:
+        with time_limit(PARSE_SECONDS, f"parsing {text[:80]!r}"):
+            expr = parse_equation(source, PARAMS)
+    except InputError as err:
+        STATS["parser rejected"] += 1
+        rendered = err.render()
+        assert rendered.startswith("<equation>:"), rendered
+        assert err.message and "Traceback" not in rendered
+        return None
+    assert isinstance(expr, sympy.Expr)
+    assert expr.free_symbols <= {X, Y, Z} and expr.free_symbols
+    STATS["parser accepted"] += 1
+    check_roundtrip(expr)
+    return expr
+
+
+_POINTS = np.random.default_rng(5).uniform(-0.9, 0.9, (3, 8))
+ROOMY = Limits(max_chars=10**7, max_depth=10**4, max_nodes=10**7, max_exponent=10**4,
+               max_degree=10**5, max_terms=10**12, max_literal_exponent=330,
+               max_constant_digits=3000)
+
+
+def check_roundtrip(expr: sympy.Expr) -> None:
+    """The printed equation (shader headers, `implc show`) parses back to the same S."""
+    from implc.numeric import evaluate
+    from implc.textform import to_text
+
+    text = to_text(expr)
+    with time_limit(PARSE_SECONDS, f"re-parsing {text[:80]!r}"):
+        # the printed form states folded constants (1e-16 * 1e-16 = 1e-32) that are
+        # outside the literal range, and spells real roots out: parse it with room
+        again = parse_equation(Source("<printed>", text), limits=ROOMY)
+    env = dict(zip((X, Y, Z), _POINTS, strict=True))
+    a, b = evaluate(expr, env), evaluate(again, env)
+    a, b = np.broadcast_to(a, (8,)), np.broadcast_to(b, (8,))
+    # Compared where S is defined: the printed form of a pow-semantics power with an odd
+    # denominator (y^0.0072 * y^0.0072 = y^(9/625), NaN for y < 0) reads back as a real
+    # root, defined there (textform, reported in docs/CORPUS.md).
+    defined = np.isfinite(a)
+    assert np.isfinite(b[defined]).all(), f"{expr} printed as {text}: {a} {b}"
+    both = defined
+    scale = 1.0 + np.abs(a[both]).max(initial=0.0)
+    np.testing.assert_allclose(b[both], a[both], rtol=1e-9, atol=1e-9 * scale,
+                               err_msg=f"{expr} printed as {text}")
+
+
+_SHADERS: list[str] = []  # a reservoir of emitted shaders, validated at the end of a test
+
+
+def check_path(expr: sympy.Expr, rng: random.Random) -> None:
+    """Property 2 (and a sample for property 3) on a parsed expression."""
+    from implc.derive import derive_limits
+    from implc.emit import emit
+    from implc.surface import Surface
+
+    STATS["path"] += 1
+    surface = Surface("fuzz", expr)
+    try:
+        with time_limit(PATH_SECONDS, f"compiling {expr}"), derive_limits(PATH_MAX_DERIVED):
+            text = emit(surface, "glsl", rng.choice(["hessian", "taylor", "curvature"]))
+    except ImplcError as err:
+        STATS["path rejected"] += 1
+        assert str(err).startswith("too complex: "), err
+        return
+    STATS["path emitted"] += 1
+    if rng.random() < 0.25:
+        _SHADERS.append(text)
+
+
+def validate_sample(limit: int) -> None:
+    """Property 3: every sampled shader validates (glslangValidator), then empty the pool."""
+    from conftest import require_tool
+
+    from implc.validate import validate_glsl
+
+    require_tool("glslangValidator")
+    pool, _SHADERS[:] = list(_SHADERS), []
+    for text in random.Random(len(pool)).sample(pool, min(limit, len(pool))):
+        verdict = validate_glsl(text, "fuzz.frag")
+        STATS["validated"] += 1
+        assert verdict.ok, f"{verdict.messages}\n--- shader header:\n{text[:600]}"
+
+
+@pytest.fixture(scope="module", autouse=True)
+def summary():
+    start = time.perf_counter()
+    yield
+    elapsed = time.perf_counter() - start
+    line = (f"fuzz: {STATS['parser']} parser cases ({STATS['parser accepted']} parsed, "
+            f"{STATS['parser rejected']} rejected), {STATS['path']} whole-path cases "
+            f"({STATS['path emitted']} shaders, {STATS['path rejected']} over the bound), "
+            f"{STATS['validated']} validated; {STATS['parser'] + STATS['path']} cases in "
+            f"{elapsed:.0f} s")
+    print("\n" + line)
+    out = os.environ.get("IMPLC_FUZZ_SUMMARY")
+    if out:
+        Path(out).write_text(line + "\n", encoding="utf-8")
+
+
+@profile(600)
+@given(EQUATIONS)
+def test_grammar_parser(text):
+    check_parse(text)
+
+
+@profile(400)
+@given(mutants())
+def test_mutation_parser(text):
+    check_parse(text)
+
+
+@profile(150)
+@given(EQUATIONS, st.randoms(use_true_random=False))
+def test_grammar_whole_path(text, rng):
+    expr = check_parse(text)
+    assume(expr is not None)
+    check_path(expr, rng)
+
+
+@profile(80)
+@given(mutants(), st.randoms(use_true_random=False))
+def test_mutation_whole_path(text, rng):
+    expr = check_parse(text)
+    assume(expr is not None)
+    check_path(expr, rng)
+
+
+def test_sampled_shaders_validate():
+    """Runs after the whole-path tests (file order) on the shaders they kept."""
+    validate_sample(examples(25))
+
+
+# --------------------------------------------------------------------------- findings
+
+# Inputs the fuzzers found, each fixed; pinned here with the outcome they must have
+# ("ok": parses, compiles and validates on every target; else the start of the parser's
+# message). Diagnostics found by fuzzing are pinned in tests/data/malformed.txt too.
+REGRESSIONS: list[tuple[str, str]] = [
+    # sympy left d|acos(x)|/dx as re/im terms and d sign(acos(x))/dx as an unevaluated
+    # Derivative: the printer raised (implc.derive.branch_diff)
+    ("acos(x)^(1/3) + y", "ok"),
+    ("abs(log(x)) + y^2 + z", "ok"),
+    ("sign(sqrt(x)) + abs(asin(y)) + z - 1", "ok"),
+    ("x^(1/3) + acos(y/2)^(2/3) + z", "ok"),
+    # a non-real constant reached the printer ("the constant acos(pi) is not ...")
+    ("acos(pi) x", "value is not a real number"),
+    # hangs in sympy's exact arithmetic, now bounded before sympy starts
+    ("1 ** 4E-21^1e-30 x", "too complex: root of a constant"),
+    ("R^abs(7e23) * (pi) + x", "too complex: constant power"),
+    ("e^(10^20*log(2)) + x", "too complex: constant power"),
+    ("x^(sin(pi) + 1000)", "too complex: exponent 1000"),
+    # folded constants outside the literal range still print and re-parse (roundtrip)
+    ("x(1e-15)(1e-16)", "ok"),
+    ("x(2)(1e30)", "ok"),
+    ("y^0.0072*y^0.0072 + x", "ok"),
+    # a constant base <= 0 with a variable exponent: log(b) in the derivatives was nan
+    ("0^x", "the base of a variable exponent must be positive"),
+    ("(1-pi)^x + y", "the base of a variable exponent must be positive"),
+    ("sin(0)^x + y", "the base of a variable exponent must be positive"),
+]
+
+
+@pytest.mark.parametrize(("text", "outcome"), REGRESSIONS)
+def test_fuzz_regressions(text, outcome):
+    from conftest import require_tool
+
+    from implc.emit import emit
+    from implc.surface import Surface
+    from implc.validate import validate_text
+
+    if outcome != "ok":
+        with pytest.raises(InputError, match="^" + re.escape(outcome)):
+            parse_equation(Source("<equation>", text), PARAMS)
+        return
+    expr = check_parse(text)
+    assert expr is not None
+    require_tool("glslangValidator")
+    for target in ("glsl", "wgsl", "opencl"):
+        shader = emit(Surface("regression", expr), target, "hessian")
+        verdict = validate_text(shader, target, f"regression.{target}")
+        assert verdict.ok, verdict.messages
