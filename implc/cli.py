@@ -362,7 +362,8 @@ def cmd_render(args) -> int:
     elapsed = time.perf_counter() - start
     for path in paths:
         print(f"wrote {path}")
-    print(f"rendered {width}x{height} with {backend}/{args.method} in {elapsed:.2f} s",
+    what = backend if backend == "reference" else f"{backend}/{args.method}"
+    print(f"rendered {width}x{height} with {what} in {elapsed:.2f} s",
           file=sys.stderr)
     return EXIT_OK
 
