@@ -8,7 +8,7 @@ OUT := out
 # Vulkan loader + lavapipe for wgpu.
 APT_PACKAGES := glslang-tools libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1
 
-.PHONY: setup demo test golden lint bench clean system-packages
+.PHONY: setup demo test golden lint bench clean system-packages fuzz corpus
 
 setup: system-packages $(STAMP)
 
@@ -53,6 +53,21 @@ lint: setup
 BENCH_SIZE := 1024
 bench: setup
 	$(PY) -m implc bench cross-cap miter steiner --size $(BENCH_SIZE) --frames 3 -o results/
+
+# Fuzzing (tests/test_fuzz.py) at FUZZ_SCALE times the short pass that `make test` runs
+# (FUZZ_PATH_SCALE for the slower whole-path tests), a fresh seed each run: 100,000+
+# parser cases (grammar + mutation) and ~4,600 whole-path cases (parse, derive, CSE,
+# GLSL; 500 shaders validated by glslangValidator). It prints its counts and time.
+FUZZ_SCALE := 100
+FUZZ_PATH_SCALE := 20
+fuzz: setup
+	IMPLC_FUZZ_SCALE=$(FUZZ_SCALE) IMPLC_FUZZ_PATH_SCALE=$(FUZZ_PATH_SCALE) \
+	  $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider -q -s \
+	  -W ignore::hypothesis.errors.HypothesisWarning
+
+# The corpus report (docs/CORPUS.md) from ../shared/corpus/ (about 70 s with 2 workers).
+corpus: setup
+	$(PY) -m implc corpus -j 2 -o docs/CORPUS.md
 
 clean:
 	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache

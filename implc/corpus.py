@@ -495,6 +495,8 @@ def render_report(
     for r in failed:
         lines.append(f"- row {r.row.number} ({r.row.project}, {_cell(r.row.name)}): "
                      f"{_cell(r.reason)}")
+    lines += ["", "## Dialects: what implc accepts from other programs, and why", "",
+              *DIALECT_NOTES]
     slow = sorted(results, key=lambda r: -r.seconds)[:5]
     lines += ["", "## Slowest rows", "", "| row | name | degree | seconds |",
               "|---:|---|---:|---:|"]
@@ -502,6 +504,28 @@ def render_report(
         lines.append(f"| {r.row.number} | {_cell(r.row.name)} | "
                      f"{r.row.degree if r.row.degree is not None else ''} | {r.seconds:.1f} |")
     return "\n".join(lines) + "\n"
+
+
+DIALECT_NOTES = (
+    "- `PI` is accepted as `pi`: surf and SURFER write it (rows 155 and 165 of the "
+    "surf gallery failed on it alone). `E` is not an alias: MathMod and others use it as "
+    "a parameter name.",
+    "- `**`, `[ ]` and implicit products (`2x`, `x y`, `(x+1)(x-1)`) were already part of "
+    "the language; every corpus dialect writes `^` or `*` otherwise.",
+    "- Not accepted, with a hint instead: `ln`, `arcsin`, `sgn`, `fabs` (\"did you mean "
+    "'log'?\"), `pow(a, b)` (\"use '^' for powers\": GLSL's `pow` is undefined for a < 0 "
+    "where implc's `^` has a documented meaning), `x²`, `−`, `π`. None occurs in the "
+    "corpus; guessing would make two spellings of one thing.",
+    "- Not accepted: upper-case variables (`X`): names are case sensitive and `A`, `B`, "
+    "`C`, `R`, `W` are parameters in the corpus.",
+    "- Rejected with the upstream reason: helpers defined in the upstream program's own "
+    "code (ImpVis `T_n`, `S_5`, `phi`; MathMod `NoiseW`, `if(...)`, `mandelbulb`), "
+    "realsurf's free parameters (sliders whose values the corpus does not give), and "
+    "three MathMod rows over the degree or exponent limits (degree 48 and 50, `x^100`; "
+    "`--max-degree 100 --max-exponent 100` compiles them).",
+    "- On the command line an equation starting with `-` (a quarter of the MathMod rows) "
+    "is taken as the equation: `implc compile -e \"-x^2 - y^2 + z\"`.",
+)
 
 
 def _cell(text: str) -> str:

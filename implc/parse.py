@@ -942,8 +942,8 @@ class _Analyzer:
                 return 1, 0
             bits = max(abs(value.numerator).bit_length(), value.denominator.bit_length())
             return 1, bits * _LOG10_2 // 100_000 + 1
-        if isinstance(node, _Neg):
-            return parts[0]
+        if isinstance(node, _Neg) or (isinstance(node, _Call) and node.name == "abs"):
+            return parts[0]  # |9e28 y| is 9e28 |y| to sympy
         if isinstance(node, _Product):
             root, digits = 1, 0
             for r, d in parts:
@@ -1113,7 +1113,11 @@ class _Analyzer:
     def fold_power(self, node: _Power, base: Fraction, power: Fraction, size: int) -> _Info:
         """A rational constant to a rational power: bound the result's size, then fold."""
         if base not in (0, 1, -1):
-            bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length()) - 1
+            bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length())
+            # an integer power is computed and checked exactly below, so a lower bound on
+            # log2(base) does; a root is not, so it needs the upper one (3^647.1 is 1e308:
+            # it reached the printer as inf; found by tests/test_fuzz.py)
+            bits -= power.denominator == 1
             digits_bound = self.limits.max_constant_digits * 100_000 * power.denominator
             if abs(power.numerator) * bits * _LOG10_2 > digits_bound:
                 raise _constant_digits_error(
@@ -1131,6 +1135,16 @@ class _Analyzer:
         copies = _argument_copies(node.name)
         size = 1 + sum(n * a.size for n, a in zip(copies, args, strict=True))
         return _Info(constant, None, 0 if constant else 1, 1, False, size)
+
+
+def _approx(expr: sympy.Expr) -> sympy.Expr:
+    """`expr.evalf(15)`, or the imaginary unit when sympy cannot evaluate it: it raises
+    when it compares a non-real value inside min/max (`max(2, cos(2)^0.5)`, found by
+    tests/test_fuzz.py), and every caller then reports "not a real number"."""
+    try:
+        return expr.evalf(15)
+    except (TypeError, ValueError, ArithmeticError):
+        return sympy.I
 
 
 def _power_terms(terms: int, n: int, max_terms: int) -> int:
@@ -1161,6 +1175,9 @@ class _Builder:
         self.info = info
         self.limits = limits
         self.analyzer = _Analyzer(source, params, limits)
+        # nodes holding a rational only sympy found (abs(9e28)): the analysis' radical
+        # bound did not see it, so make_power checks powers of them again
+        self.late: set[_Node] = set()
 
     def fail(self, message: str, node: _Node) -> InputError:
         return InputError(message, self.source, node.start, node.end - node.start)
@@ -1175,12 +1192,63 @@ class _Builder:
                 # sympy found an exact value the analysis could not (abs(7e23), sin(0),
                 # exp(2 log 3)): bound it like every other exact constant
                 self.analyzer.checked_value(Fraction(built[node].p, built[node].q), node)
+                self.late.add(node)
+            elif any(c in self.late for c in _children(node)):
+                self.late.add(node)
+        self.check_constants(order, built)
         result = built[root]
         if result.has(*(atom for atom, _ in _NON_REAL_MESSAGES)):
             raise self.locate_non_real(order, built)
+        self.check_numbers(order, built)
         if not result.free_symbols & {X, Y, Z}:
             raise self.fail("equation does not depend on x, y or z", root)
         return result
+
+    def check_constants(self, order: list[_Node], built: Mapping[_Node, sympy.Expr]) -> None:
+        """Every maximal constant sub-expression must be a finite real number of at most
+        `max_constant_digits` digits (and within float range): printers fold each one to
+        a float literal. Catches what only sympy can evaluate: `cos(-5/2)^(3/4)` is not
+        real, `pi^64 * 10^290 * e^64` overflows (both found by tests/test_fuzz.py).
+        Each constant sub-tree is evaluated once, at its top."""
+        inside: set[_Node] = set()
+        for node in order:
+            if not self.info[node].constant:
+                inside.update(c for c in _children(node) if self.info[c].constant)
+        exponent = min(self.limits.max_constant_digits, 300)
+        for node in order:
+            if node not in inside or self.info[node].value is not None:
+                continue
+            approx = _approx(built[node])
+            if approx.has(sympy.nan):
+                raise self.fail("value is undefined", node)
+            if approx.has(sympy.zoo, sympy.oo, -sympy.oo):
+                raise self.fail("value is infinite", node)
+            if approx.is_real is False or not approx.is_number:
+                raise self.fail("value is not a real number", node)
+            if approx.is_real and abs(approx) >= sympy.Float(10) ** exponent:
+                raise _constant_digits_error(
+                    "constant value", self.limits, self.source, node.start,
+                    node.end - node.start,
+                )
+
+    def check_numbers(self, order: list[_Node], built: Mapping[_Node, sympy.Expr]) -> None:
+        """Every constant factor sympy split off must be real too: sqrt(tan(phi) x^2) is
+        sqrt(tan(phi)) |x| to sympy, and tan(phi) < 0 (found by tests/test_fuzz.py).
+        Walks the finished expression once; located at the innermost node holding it."""
+        stack, seen = [built[order[-1]]], set()
+        while stack:
+            expr = stack.pop()
+            if expr in seen or expr.is_Atom:
+                continue
+            seen.add(expr)
+            if not expr.is_number:
+                stack.extend(expr.args)
+                continue
+            approx = _approx(expr)
+            if approx.is_real is not False and not approx.has(sympy.nan, sympy.zoo, sympy.oo):
+                continue
+            node = next(n for n in order if built[n].has(expr))
+            raise self.fail("value is not a real number", node)
 
     def locate_non_real(self, order: list[_Node], built: Mapping[_Node, sympy.Expr]) -> InputError:
         """The innermost node whose value is not a finite real number."""
@@ -1233,13 +1301,35 @@ class _Builder:
         if power is None and exponent.is_Rational:  # sympy evaluated it (2^abs(7e23))
             power = Fraction(exponent.p, exponent.q)
             self.check_late_power(node, base, power)
+        elif power is not None and node.base in self.late:  # abs(9e28)^(4000000/3381921)
+            self.check_late_power(node, base, power)
+        if (power is not None and self.info[node.base].constant and not base.is_Rational
+                and power.denominator == 1):  # pi^64 is fine; (1e20 pi)^64 is 10^1280 pi^64
+            self.check_magnitude(node, exponent * sympy.log(sympy.Abs(base)), "constant power")
+        if base == sympy.E or isinstance(base, sympy.exp):  # sympy makes it exp(...)
+            inner = exponent if base == sympy.E else base.args[0] * exponent
+            self.check_exp_argument(node, inner)
+        if power is None and not self.info[node.base].constant:  # x^(1e26^6.1) is x^4e158
+            approx = abs(_approx(exponent))
+            if approx.is_real and approx > self.limits.max_exponent:
+                raise self.analyzer.limit(
+                    f"exponent about {float(approx):.3g} exceeds the limit of "
+                    f"{self.limits.max_exponent} (--max-exponent)",
+                    node.exponent,
+                )
         if power is None:
             if self.info[node.base].constant and not self.info[node.exponent].constant:
                 # b^x = exp(x log b): its derivatives need log b, so b must be positive
                 # (`0^x` and `(1-pi)^x` reached the printer as nan; found by test_fuzz.py)
-                approx = base.evalf(15)
+                approx = _approx(base)
                 if not (approx.is_real and approx.is_positive):
                     raise self.fail("the base of a variable exponent must be positive", node)
+                if base != 1 and abs(_approx(sympy.log(base))) < 1e-15:
+                    # sympy cannot decide the sign of log(b) at working precision and
+                    # raises while differentiating (tanh(32)^x; found by test_fuzz.py)
+                    raise self.fail(
+                        "the base of a variable exponent is 1 to 15 digits (write 1)", node
+                    )
             if self.info[node.base].constant and self.info[node.exponent].constant:
                 self.check_magnitude(
                     node, exponent * sympy.log(sympy.Abs(base)), "constant power"
@@ -1254,8 +1344,20 @@ class _Builder:
         return sympy.sign(base) * magnitude if power.numerator % 2 else magnitude
 
     def check_late_power(self, node: _Power, base: sympy.Expr, power: Fraction) -> None:
-        """The limits of `_Analyzer.visit_power` for an exponent only sympy could evaluate
-        (`x^(sin(pi) + 1000)`, `2^abs(7e23)`), before sympy computes the power."""
+        """The limits of `_Analyzer.visit_power` for a base or exponent only sympy could
+        evaluate (`x^(sin(pi) + 1000)`, `2^abs(7e23)`, `abs(9e28)^(4000000/3381921)`),
+        before sympy computes the power."""
+        if power.denominator != 1 and not base.is_Rational:
+            # rationals inside the base combine under the root (`(abs(4e-21) x)^(1/q)`)
+            roots = [a.exp.q for a in base.atoms(sympy.Pow) if a.exp.is_Rational]
+            digits = max((len(str(max(abs(r.p), r.q))) for r in base.atoms(sympy.Rational)
+                          if r not in (0, 1, -1)), default=0)
+            if digits and power.denominator * max(roots, default=1) * digits > (
+                    10 * self.limits.max_constant_digits):
+                raise _constant_digits_error(
+                    "root of a constant", self.limits, self.source, node.start,
+                    node.end - node.start,
+                )
         if base.is_Rational:
             self.analyzer.fold_power(node, Fraction(base.p, base.q), power, 0)
             if power.denominator != 1:
@@ -1285,7 +1387,7 @@ class _Builder:
         `max_constant_digits` digits: sympy may compute it exactly (`e^(1e20 log 2)`
         becomes 2^(10^20)). The estimate is numeric and cheap."""
         try:
-            estimate = abs(complex(log_value.evalf(15)))
+            estimate = abs(complex(_approx(log_value)))
         except (TypeError, ValueError):  # not a plain number (nan, zoo): found later
             return
         if estimate / math.log(10) > self.limits.max_constant_digits:
@@ -1293,21 +1395,52 @@ class _Builder:
                 what, self.limits, self.source, node.start, node.end - node.start
             )
 
+    def check_exp_argument(self, node: _Node, arg: sympy.Expr) -> None:
+        """sympy rewrites exp(a + k log(u)) as e^a u^k on construction, for any numeric k
+        (`e^(10^20 log(2x))` computed 2^(10^20) and hung; found by tests/test_fuzz.py;
+        `exp(100 log(x))` would be x^100, past --max-exponent). Bound k as an exponent of
+        u before sympy sees it: |k| <= max_exponent when u depends on x, y, z, and the
+        magnitude of u^k when it does not."""
+        for term in sympy.Add.make_args(arg):
+            coeff, rest = term.as_coeff_Mul()
+            logs = [f for f in sympy.Mul.make_args(rest) if isinstance(f, sympy.log)]
+            others = [f for f in sympy.Mul.make_args(rest) if not isinstance(f, sympy.log)]
+            if len(logs) != 1 or not all(f.is_comparable for f in others):
+                continue
+            k, u = coeff * sympy.Mul(*others), logs[0].args[0]
+            if not u.free_symbols & {X, Y, Z}:
+                self.check_magnitude(node, k * sympy.log(sympy.Abs(u)), "constant power")
+                continue
+            try:
+                magnitude = abs(float(k))
+            except (TypeError, ValueError, OverflowError):
+                magnitude = math.inf
+            if magnitude > self.limits.max_exponent:
+                raise self.analyzer.limit(
+                    f"exponent about {magnitude:.3g} (exp(k log u) is u^k) exceeds the "
+                    f"limit of {self.limits.max_exponent} (--max-exponent)",
+                    node,
+                )
+
     def make_call(self, node: _Call, built: Mapping[_Node, sympy.Expr]) -> sympy.Expr:
         function = USER_FUNCTIONS[node.name]
         args = [built[a] for a in node.args]
+        if node.name == "exp":
+            self.check_exp_argument(node, args[0])
         if node.name in _GROWING and self.info[node.args[0]].constant:
             self.check_magnitude(node, args[0], "constant value")  # exp(k log r) is r^k
         if function.sympy_name in _UNEVALUATED:
             expr = function.build(*args, evaluate=False)
         else:
             expr = function.build(*args)
+        if expr.has(sympy.cot):  # tan(x + 3pi/4) is -cot(x + pi/4) to sympy; no target has cot
+            expr = expr.replace(sympy.cot, lambda u: 1 / sympy.tan(u))
         if all(self.info[a].constant for a in node.args):
             # Constant arguments are bounded (every check above ran on them), so evalf is
             # cheap; it finds asin(2) or acos(pi), which sympy leaves unevaluated although
             # they are not real (found by tests/test_fuzz.py: `acos(pi) x` reached the
             # printer).
-            approx = expr.evalf(15)
+            approx = _approx(expr)
             if approx.has(sympy.nan):
                 raise self.fail("value is undefined", node)
             if approx.has(sympy.zoo, sympy.oo, -sympy.oo):

@@ -2,7 +2,7 @@
 
 The cases live in tests/data/hostile.txt. They run in one child process (started with a
 2 GiB address-space limit) that calls `implc.cli.main` once per case with a 5 s timer,
-so ~140 cases cost one interpreter start; a few are also run as separate real
+so all 164 cases cost one interpreter start; a few are also run as separate real
 `python -m implc compile` processes to check exit codes and files end to end. The same
 file holds the resource-bound tests (over-large input that the parser accepts, stopped by
 `--max-derived` before differentiation) and the interrupt test (SIGINT mid-compile).
@@ -360,15 +360,25 @@ def test_every_limit_has_its_option():
 SLOW = "sin(" * 30 + "x*y*z" + ")" * 30
 
 
-@pytest.mark.parametrize("delay", [1.5, 3.0])
-def test_sigint_mid_compile_leaves_nothing(tmp_path, delay):
+def _cpu_seconds(pid: int) -> float:
+    """User + system CPU time of a running process (Linux /proc)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+@pytest.mark.parametrize("cpu", [1.5, 3.0])
+def test_sigint_mid_compile_leaves_nothing(tmp_path, cpu):
+    """SIGINT after `cpu` seconds of work: past the imports (~0.6 s), inside derive/CSE
+    (~6 s in all). CPU time, not wall time, so a loaded machine does not shift it."""
     out = tmp_path / "slow.frag"
     proc = subprocess.Popen(
         [sys.executable, "-m", "implc", "compile", "-e", SLOW, "-o", str(out)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
         env={**os.environ, "PYTHONPATH": str(ROOT)}, preexec_fn=limit_memory,
     )
-    time.sleep(delay)
+    deadline = time.monotonic() + 60
+    while proc.poll() is None and _cpu_seconds(proc.pid) < cpu and time.monotonic() < deadline:
+        time.sleep(0.05)
     assert proc.poll() is None, "finished before it could be interrupted"
     proc.send_signal(signal.SIGINT)
     stdout, stderr = proc.communicate(timeout=30)
