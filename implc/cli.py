@@ -426,7 +426,7 @@ def cmd_corpus(args) -> int:
                                 progress=progress)
     wall = time.perf_counter() - start
     if args.output:
-        report = corpus.render_report(results, str(tsv), args.targets, wall, jobs,
+        report = corpus.render_report(results, os.path.relpath(tsv), args.targets, wall, jobs,
                                       validate=not args.no_validate)
         write_atomic(args.output, report)
         print(f"wrote {args.output}", file=sys.stderr)

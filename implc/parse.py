@@ -1238,9 +1238,19 @@ class _Builder:
         stack, seen = [built[order[-1]]], set()
         while stack:
             expr = stack.pop()
-            if expr in seen or expr.is_Atom:
+            if expr in seen:
                 continue
             seen.add(expr)
+            if expr.is_Rational:  # (1e30 x)^11 is 10^330 x^11: a float literal would be inf
+                if _too_many_digits(Fraction(expr.p, expr.q), self.limits.max_constant_digits):
+                    node = next(n for n in order if built[n].has(expr))
+                    raise _constant_digits_error(
+                        "constant value", self.limits, self.source, node.start,
+                        node.end - node.start,
+                    )
+                continue
+            if expr.is_Atom:
+                continue
             if not expr.is_number:
                 stack.extend(expr.args)
                 continue
