@@ -65,7 +65,7 @@ fuzz: setup
 	  $(PY) -m pytest tests/test_fuzz.py -p no:cacheprovider -q -s \
 	  -W ignore::hypothesis.errors.HypothesisWarning
 
-# The corpus report (docs/CORPUS.md) from ../shared/corpus/ (about 70 s with 2 workers).
+# The corpus report (docs/CORPUS.md) from ../shared/corpus/ (40-70 s with 2 workers).
 corpus: setup
 	$(PY) -m implc corpus -j 2 -o docs/CORPUS.md
 
