@@ -18,7 +18,7 @@ from .derive import Derivatives, current_max_derived
 from .errors import InputError
 from .methods import Constants, Method, get_method
 from .optimize import Program, optimize
-from .render.scene import SHADING, View, light_directions
+from .scene import SHADING, View, light_directions
 from .resources import data_dir
 from .surface import Surface
 from .symbols import DIRECTION, POINT

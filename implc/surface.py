@@ -29,7 +29,7 @@ import sympy
 
 from .errors import InputError, Source
 from .parse import Limits, check_param_name, parse_equation, parse_number
-from .render.scene import View
+from .scene import View
 from .resources import data_dir
 from .textform import to_text
 

@@ -17,7 +17,7 @@ from implc.render.reference import (
     ray_polynomial,
     render_reference,
 )
-from implc.render.scene import View, clip_sphere, pixel_rays
+from implc.scene import View, clip_sphere, pixel_rays
 from implc.symbols import X, Y, Z
 
 R_SPHERE = 1.0

@@ -18,7 +18,7 @@ from implc.derive import Derivatives
 from implc.methods import METHODS
 from implc.numeric import evaluate
 from implc.render.run import render
-from implc.render.scene import pixel_rays
+from implc.scene import pixel_rays
 from implc.surface import load_surface
 from implc.symbols import POINT
 

@@ -27,7 +27,7 @@ from ..errors import ToolError
 from ..methods import Constants
 from ..surface import Surface
 from .result import RenderResult, TimedRunner
-from .scene import View
+from ..scene import View
 
 POCL = "Portable Computing Language"
 FP64 = "cl_khr_fp64"

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import ToolError
 from .result import RenderResult, TimedRunner
-from .scene import View
+from ..scene import View
 
 TRIANGLES = 0x0004  # GL_TRIANGLES
 

@@ -28,7 +28,7 @@ from sympy.polys.rings import ring
 from ..numeric import evaluate
 from ..symbols import DIRECTION, POINT, T, X, Y, Z
 from .result import RenderResult
-from .scene import View, clip_sphere, pixel_rays, shade
+from ..scene import View, clip_sphere, pixel_rays, shade
 
 # Ray origin symbols of the coefficient expressions returned by `ray_polynomial`.
 OX, OY, OZ = sympy.symbols("ox oy oz", real=True)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import ToolError
 from .result import RenderResult, TimedRunner
-from .scene import View
+from ..scene import View
 
 WORKGROUP = 8  # the workgroup size (8 x 8) in templates/wgsl/program.wgsl.j2
 COLOR_FORMAT = "rgba32float"  # storage-writable in core WebGPU, and exact like GL's f4
