@@ -5,8 +5,10 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.implc-installed
 OUT := out
 # Debian packages: glslangValidator, headless EGL/Mesa for moderngl (llvmpipe),
-# Vulkan loader + lavapipe for wgpu.
-APT_PACKAGES := glslang-tools libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1
+# Vulkan loader + lavapipe for wgpu, Debian's PoCL (its LLVM 15 builds for CPUs the PoCL wheel
+# cannot name, e.g. AMD Zen 5: see implc/render/cl_runner.py device()).
+APT_PACKAGES := glslang-tools libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
+  pocl-opencl-icd
 
 .PHONY: setup demo test golden lint bench clean system-packages fuzz corpus
 

@@ -243,7 +243,7 @@ def numeric_check(expr, seed: int, n: int = 96) -> str:
     import numpy as np
 
     from .derive import Derivatives
-    from .emit import build_functions
+    from .emit import build_functions, function_quantities
     from .methods import get_method
     from .numeric import evaluate, evaluate_program
     from .symbols import DIRECTION, POINT
@@ -287,7 +287,7 @@ def numeric_check(expr, seed: int, n: int = 96) -> str:
                         f"({int(bad.sum())} of {n} points)")
         method = get_method(METHOD)
         for name, program in build_functions(expr, method).items():
-            original = [e for q in method.all_functions()[name] for e in d.quantity(q)]
+            original = [e for q in function_quantities(method)[name] for e in d.quantity(q)]
             got = evaluate_program(program.assignments, program.outputs, here)
             for k, (g, o) in enumerate(zip(got, original, strict=True)):
                 want = np.broadcast_to(evaluate(o, here), (n,))

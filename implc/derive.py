@@ -206,3 +206,17 @@ def polynomial_degree(expr: sympy.Expr) -> int | None:
     if not expr.is_polynomial(*POINT):
         return None
     return int(sympy.Poly(expr, *POINT).total_degree())
+
+
+RAY_PARAMETER = sympy.Symbol("s", real=True)
+
+
+def ray_coefficients(expr: sympy.Expr) -> tuple[sympy.Expr, ...] | None:
+    """c_0 .. c_n of the ray polynomial F(s) = S(o + s d) = sum c_k s^k, as polynomials in
+    the origin o = (x, y, z) and the direction d = (dx, dy, dz); None when S is not a
+    polynomial. (The `ray-poly` evaluation form computes them once per ray.)"""
+    if polynomial_degree(expr) is None:
+        return None
+    s = RAY_PARAMETER
+    moved = expr.xreplace({v: v + s * d for v, d in zip(POINT, DIRECTION, strict=True)})
+    return tuple(sympy.Poly(moved, s).all_coeffs()[::-1])

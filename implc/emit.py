@@ -1,46 +1,36 @@
 """Program + Target + Method -> shader text, through jinja2 templates.
 
-Python decides what to compute (derive, optimize) and prints every expression and number;
-templates (templates/<target>/) hold all shader text and do no math. Rendering is
+Python decides what to compute (derive, optimize, implc/marcher.py's lowering of the
+method) and prints every expression and number; templates hold all shader text and do no
+math: templates/marcher.j2 is the marcher skeleton of every target, spelled by
+templates/<target>/lang.j2, inside the target's program or library frame. Rendering is
 strict: a name a template uses but emit does not give is an error, not an empty string.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
 
 import jinja2
 import sympy
 
 from .backends import get_target
-from .derive import Derivatives, current_max_derived
+from .derive import current_max_derived
 from .errors import InputError
+from .marcher import build_programs, choose_form, function_name, lower, point_sets
 from .methods import Constants, Method, get_method
-from .optimize import Program, optimize
-from .scene import SHADING, View, light_directions
+from .optimize import Program
 from .resources import data_dir
+from .scene import SHADING, View, light_directions
 from .surface import Surface
-from .symbols import DIRECTION, POINT
 
 EMITS = ("program", "library")
 PREFIX_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 
 
-@dataclass(frozen=True)
-class ShaderFunction:
-    """One straight-line shader function: its inputs, code lines and returned values."""
-
-    name: str
-    uses_direction: bool
-    assignments: tuple[tuple[str, str], ...]
-    outputs: tuple[str, ...]
-    program: Program
-
-
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
-    return jinja2.Environment(
+    env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(data_dir("templates"))),
         undefined=jinja2.StrictUndefined,
         keep_trailing_newline=True,
@@ -48,38 +38,23 @@ def environment() -> jinja2.Environment:
         lstrip_blocks=True,
         autoescape=False,
     )
+    # (abstract type, name) -> (the target's type, name), for function parameters
+    env.filters["typed"] = lambda pair, types: (types[pair[0]], pair[1])
+    env.filters["typed3"] = lambda field, types: (types[field[0]], *field[1:])
+    return env
+
+
+def function_quantities(method: Method) -> dict[str, tuple[str, ...]]:
+    """Shader function name -> the quantities it returns, for the method's program."""
+    return {function_name(q): q for q in point_sets(method)}
 
 
 def build_functions(expr: sympy.Expr, method: Method) -> dict[str, Program]:
-    """Derive and optimize every function the method needs (jointly CSE'd per function).
+    """Derive and optimize every point function the method needs in the point form
+    (jointly CSE'd per function).
 
     Raises `LimitError` first when the derivatives would exceed `--max-derived`."""
-    return dict(_build_functions(expr, method.name, current_max_derived()))
-
-
-@lru_cache(maxsize=32)
-def _build_functions(
-    expr: sympy.Expr, method_name: str, max_derived: int
-) -> tuple[tuple[str, Program], ...]:
-    method = get_method(method_name)
-    derivatives = Derivatives(expr, max_derived)
-    programs: dict[str, Program] = {}
-    for name, quantities in method.all_functions().items():
-        outputs = [e for q in quantities for e in derivatives.quantity(q)]
-        needs_direction = any(q in ("dS", "d2S") for q in quantities)
-        inputs = POINT + DIRECTION if needs_direction else POINT
-        programs[name] = optimize(outputs, inputs)
-    return tuple(programs.items())
-
-
-def print_function(name: str, program: Program, printer) -> ShaderFunction:
-    return ShaderFunction(
-        name=name,
-        uses_direction=len(program.inputs) == 6,
-        assignments=tuple((s.name, printer.doprint(v)) for s, v in program.assignments),
-        outputs=tuple(printer.doprint(o) for o in program.outputs),
-        program=program,
-    )
+    return build_programs(expr, point_sets(method), current_max_derived())
 
 
 def emit(
@@ -91,6 +66,7 @@ def emit(
     emit: str = "program",
     prefix: str = "",
     precision: str | None = None,
+    evaluation: str = "auto",
 ) -> str:
     """The complete shader text for `surface` (deterministic, byte for byte)."""
     tgt = get_target(target)
@@ -108,17 +84,20 @@ def emit(
     if precision not in tgt.precisions:
         raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
     printer = tgt.printer(precision) if len(tgt.precisions) > 1 else tgt.printer()
-    functions = {
-        name: print_function(name, program, printer)
-        for name, program in build_functions(surface.expr, meth).items()
-    }
+    form = choose_form(surface.expr, evaluation)
+    marcher = lower(meth, constants, surface.expr, form, printer, prefix,
+                    current_max_derived())
+    label = meth.name + (f" (Eq. 4: {constants.taylor2})" if meth.reads_taylor2 else "")
+    literals = {"zero": 0.0, "half": 0.5, "one": 1.0}
     context = {
         "surface": {"name": surface.name, "equation": surface.equation},
         "method": meth.name,
-        "c": _print_constants(constants, printer),
-        "taylor2": constants.taylor2,
-        "functions": functions,
-        "types": tgt.vector_types,
+        "method_label": label,
+        "form": form,
+        "marcher": marcher,
+        "lang": f"{tgt.name}/lang.j2",
+        "T": _types(tgt.vector_types, precision, prefix),
+        "lit": {k: printer.float_literal(v) for k, v in literals.items()},
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
         "flavor_name": flavor,
@@ -135,17 +114,11 @@ def render_template(name: str, **context) -> str:
     return environment().get_template(name).render(context)
 
 
-def _print_constants(c: Constants, printer) -> dict[str, str]:
-    f = printer.float_literal
-    return {
-        "step": f(c.step),
-        "tau1": f(c.tau1),
-        "tau2": f(c.tau2),
-        "tau3": f(c.tau3),
-        "eps": f(c.eps),
-        "max_steps": str(int(c.max_steps)),
-        "refine_steps": str(int(c.refine_steps)),
-    }
+def _types(vector_types: tuple[str, str, str], precision: str, prefix: str) -> dict:
+    """The skeleton's abstract type names -> the target's spelling."""
+    real, vec2, vec3 = (t.replace("float", precision) for t in vector_types)
+    return {"real": real, "vec2": vec2, "vec3": vec3, "int": "i32" if real == "f32" else "int",
+            "bool": "bool", "Ray": prefix + "Ray", "Hit": prefix + "Hit"}
 
 
 def _print_shading(view: View, printer) -> dict:

@@ -1,22 +1,44 @@
-"""The method registry: what each marcher of the paper needs and its default constants.
+"""The method registry: each marcher of the paper, defined once, as data.
 
-A method names the shader functions it needs (each a list of derived quantities that are
-CSE'd together), its defaults, and the template block that implements its step rule and
-root test (templates/<target>/marcher.*.j2 branches on `method.name`). The exact
-definitions are in DESIGN.md section 4 and in the README.
+A method is three sympy expressions (DESIGN.md section 4):
+- `sample`: what it evaluates at a march point s, a triple (F, F', X) built from the ray
+  quantities F(s), dF(s), d2F(s) and lap(s) (X is the method's extra value, 0 if none);
+- `step`: the step length at the start of a step, a Piecewise over that end's sample
+  (F0, D0, X0) and the constants; a ray quantity in it (the `sign` method's F') is
+  evaluated only on the branch that reads it;
+- `root`: does [s0, s0 + h] hold a root? A `Rule` (named intermediate values, then a
+  boolean) over both ends' samples (F0, D0, X0), (F1, D1, X1) and h.
+The marcher skeleton (templates/marcher.j2) is the same for every method, and the target
+printers spell these expressions; nothing else branches on a method's name. The ray
+quantities are supplied by an evaluation form (implc/marcher.py), which a method never
+sees.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, replace
 
-# Functions every method's program uses: S for the residual and library users,
-# grad for shading, SD = (F, F') for Newton-bisection refinement.
-COMMON_FUNCTIONS: dict[str, tuple[str, ...]] = {
-    "S": ("S",),
-    "grad": ("grad",),
-    "SD": ("S", "dS"),
-}
+import sympy
+from sympy import Abs, And, Max, Min, Ne, Piecewise
+
+# The march parameter along the ray and the length of a step.
+S = sympy.Symbol("s", real=True)
+H = sympy.Symbol("h", real=True)
+# The samples (F, F', X) at the start (0) and the end (1) of a step.
+F0, D0, X0, F1, D1, X1 = sympy.symbols("F0 D0 X0 F1 D1 X1", real=True)
+# Constants, printed as the shader's named constants (prefixed, upper case).
+STEP, TAU1, TAU2, TAU3, EPS = sympy.symbols("STEP TAU1 TAU2 TAU3 EPS", real=True)
+CONSTANT_SYMBOLS = (STEP, TAU1, TAU2, TAU3, EPS)
+
+# Ray quantities a method may evaluate, as functions of the ray parameter, and the
+# derived quantity (implc/derive.py) each one is.
+F = sympy.Function("F")  # S(o + s d)
+DF = sympy.Function("dF")  # F'(s) = grad S . d
+D2F = sympy.Function("d2F")  # F''(s) = d^T H d
+LAP = sympy.Function("lap")  # Laplacian of S at o + s d
+RAY_QUANTITIES: dict[str, str] = {"F": "S", "dF": "dS", "d2F": "d2S", "lap": "lap"}
+RAY_FUNCTIONS = (F, DF, D2F, LAP)
 
 
 @dataclass(frozen=True)
@@ -37,17 +59,81 @@ class Constants:
     def as_dict(self) -> dict:
         return asdict(self)
 
+    def values(self) -> dict[sympy.Symbol, float]:
+        """The value of each constant symbol."""
+        return {STEP: self.step, TAU1: self.tau1, TAU2: self.tau2, TAU3: self.tau3,
+                EPS: self.eps}
+
 
 TAYLOR2_CHOICES = ("paper", "consistent", "extremum")
+
+
+@dataclass(frozen=True)
+class Rule:
+    """A value computed through named intermediates: `lets` in order, then `value`."""
+
+    value: sympy.Basic
+    lets: tuple[tuple[sympy.Symbol, sympy.Basic], ...] = ()
+
+
+# --- the pieces the paper's methods are made of --------------------------------------
+
+def eq2(f: sympy.Expr, df: sympy.Expr) -> sympy.Expr:
+    """Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b.
+    `df` is read only when |f| <= tau1 (nested, so a lazily evaluated F' stays lazy)."""
+    near = Piecewise((STEP / 4, Abs(df) <= TAU3), (STEP / 2, True))
+    return Piecewise((near, Abs(f) <= TAU1), (2 * STEP, Abs(f) > TAU2), (STEP, True))
+
+
+def interval_test(*values: sympy.Expr) -> sympy.Basic:
+    """0 lies in [min, max] of the values."""
+    return And(Min(*values) <= 0, Max(*values) >= 0)
+
+
+Q, R = sympy.symbols("q r", real=True)
+U0, U1, M0, M1 = sympy.symbols("u0 u1 m0 m1", real=True)
+
+# Eq. 3: first-order Taylor extension towards the midpoint from both ends.
+TAYLOR = Rule(interval_test(F0, Q, R, F1),
+              ((Q, F0 + D0 * H / 2), (R, F1 - D1 * H / 2)))
+# Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
+EQ4_PAPER = Rule(interval_test(F0, Q, R, F1),
+                 ((Q, F0 + D0 * H / 2 + X0 * H**2 / 2), (R, F1 - D1 * H / 2 + X0 * H**2 / 2)))
+# Eq. 4, consistent reading: second-order Taylor to the midpoint, (h/2)^2/2 = h^2/8.
+_CONSISTENT_LETS = ((Q, F0 + D0 * H / 2 + X0 * H**2 / 8), (R, F1 - D1 * H / 2 + X1 * H**2 / 8))
+EQ4_CONSISTENT = Rule(interval_test(F0, Q, R, F1), _CONSISTENT_LETS)
+# implc's extension: also the extremum of each end's quadratic model inside the step,
+# F(t0 + u) ~ F0 + F0' u + F0'' u^2/2 at u = -F0'/F0'' (and alike from t1), so a dip of F
+# below zero between the ends (two close crossings) is seen too.
+EQ4_EXTREMUM = Rule(
+    interval_test(F0, Q, R, F1, M0, M1),
+    _CONSISTENT_LETS + (
+        (U0, Piecewise((-D0 / X0, Ne(X0, 0)), (-1, True))),
+        (U1, Piecewise((D1 / X1, Ne(X1, 0)), (-1, True))),
+        (M0, Piecewise((F0 + D0 * U0 / 2, (U0 > 0) & (U0 < H)), (F0, True))),
+        (M1, Piecewise((F1 - D1 * U1 / 2, (U1 > 0) & (U1 < H)), (F1, True))),
+    ),
+)
+EQ4 = {"paper": EQ4_PAPER, "consistent": EQ4_CONSISTENT, "extremum": EQ4_EXTREMUM}
 
 
 @dataclass(frozen=True)
 class Method:
     name: str
     summary: str
-    functions: dict[str, tuple[str, ...]]  # extra shader functions: name -> quantities
-    defaults: Constants
-    paper_column: str  # the column of the paper's Table 1 it reproduces ("" if none)
+    sample: tuple[sympy.Expr, sympy.Expr, sympy.Expr]  # (F, F', X) at the march point s
+    step: sympy.Expr  # step length from the start sample (F0, D0, X0)
+    root: Rule | Mapping[str, Rule]  # one rule, or one per --taylor2 reading
+    defaults: Constants = field(default_factory=Constants)
+    paper_column: str = ""  # the column of the paper's Table 1 it reproduces ("" if none)
+
+    @property
+    def reads_taylor2(self) -> bool:
+        """Whether --taylor2 selects among readings of this method's root test."""
+        return not isinstance(self.root, Rule)
+
+    def root_rule(self, taylor2: str) -> Rule:
+        return self.root if isinstance(self.root, Rule) else self.root[taylor2]
 
     def constants(self, **overrides) -> Constants:
         given = {k: v for k, v in overrides.items() if v is not None}
@@ -55,24 +141,27 @@ class Method:
             raise ValueError(f"--taylor2 must be one of {', '.join(TAYLOR2_CHOICES)}")
         return replace(self.defaults, **given)
 
-    def all_functions(self) -> dict[str, tuple[str, ...]]:
-        return {**COMMON_FUNCTIONS, **self.functions}
-
 
 METHODS: dict[str, Method] = {
     m.name: m
     for m in (
         Method("sign", "Eq. 2 steps; root where F changes sign between step ends",
-               {"dS": ("dS",)}, Constants(), ""),
+               # F' is needed only near the surface: the step rule evaluates it there
+               (F(S), sympy.S.Zero, sympy.S.Zero), eq2(F0, DF(S)), Rule(F0 * F1 < 0)),
         Method("taylor", "Eq. 2 steps; first-order Taylor interval test (Eq. 3)",
-               {}, Constants(), "Taylor Test"),
+               (F(S), DF(S), sympy.S.Zero), eq2(F0, D0), TAYLOR,
+               paper_column="Taylor Test"),
         Method("curvature", "b/2 where -Laplacian(S) < 0, else 2b; Taylor test (Eq. 3)",
-               {"SDL": ("S", "dS", "lap")}, Constants(), "Mean Curvature"),
+               # kappa = -Laplacian(S): b/2 where kappa < 0, 2b where kappa >= 0
+               (F(S), DF(S), LAP(S)), Piecewise((STEP / 2, -X0 < 0), (2 * STEP, True)),
+               TAYLOR, paper_column="Mean Curvature"),
         Method("hessian", "Eq. 2 steps; Extended Taylor test (Eq. 4) with the exact Hessian",
-               {"SDH": ("S", "dS", "d2S")}, Constants(step=0.002), "Hessian Exact"),
+               (F(S), DF(S), D2F(S)), eq2(F0, D0), EQ4, Constants(step=0.002),
+               "Hessian Exact"),
         Method("hessian-approx",
                "Eq. 2 steps; Eq. 4 with F'' as a finite difference of F' along the ray",
-               {"dS": ("dS",)}, Constants(), "Hessian Approximate"),
+               (F(S), DF(S), (DF(S + EPS) - DF(S)) / EPS), eq2(F0, D0), EQ4,
+               paper_column="Hessian Approximate"),
     )
 }
 

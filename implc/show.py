@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy
 
 from .derive import Derivatives, polynomial_degree
-from .emit import build_functions
+from .emit import build_functions, function_quantities
 from .methods import Method
 from .surface import Surface
 from .textform import to_text
@@ -35,7 +35,7 @@ def describe(surface: Surface, method: Method) -> str:
     ]
     total_before = total_after = 0
     for name, program in build_functions(surface.expr, method).items():
-        quantities = ", ".join(method.all_functions()[name])
+        quantities = ", ".join(function_quantities(method)[name])
         lines.append(
             f"  {name:<5} ({quantities}): {program.ops_before:>6} -> {program.ops_after:<6}"
             f" ({len(program.assignments)} temporaries)"

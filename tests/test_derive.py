@@ -8,7 +8,7 @@ import pytest
 from cases import EXAMPLES
 
 from implc.derive import Derivatives
-from implc.emit import build_functions
+from implc.emit import build_functions, function_quantities
 from implc.methods import METHODS
 from implc.numeric import evaluate, evaluate_program
 from implc.surface import load_surface
@@ -73,7 +73,7 @@ def test_optimized_program_equals_original(example, method):
     p, u = _points(example, seed=11)
     env = _env(p, u)
     for name, program in build_functions(surface.expr, METHODS[method]).items():
-        quantities = METHODS[method].all_functions()[name]
+        quantities = function_quantities(METHODS[method])[name]
         original = [e for q in quantities for e in d.quantity(q)]
         got = evaluate_program(program.assignments, program.outputs, env)
         for g, o in zip(got, original, strict=True):

@@ -113,6 +113,48 @@ class ShaderPrinterMixin:
         """Heaviside(x): 1 for x >= 0, else 0 (the derivative of max by branch)."""
         return f"step({self.float_literal(0.0)}, {arg})"
 
+    # --- the methods' step rules and root tests (implc/methods.py) -------------------
+    def _print_Piecewise(self, expr) -> str:
+        """Nested selects; the last branch must be unconditional."""
+        *branches, (last, otherwise) = expr.args
+        if otherwise is not sympy.true:
+            raise ImplcError(f"a Piecewise without an otherwise branch: {expr}")
+        text = self._print(last)
+        for value, cond in reversed(branches):
+            text = self.print_select(self._print(cond), self._print(value), text)
+        return text
+
+    def print_select(self, cond: str, if_true: str, if_false: str) -> str:
+        """cond ? a : b (C family: only the chosen side is evaluated)."""
+        return f"({cond} ? {if_true} : {if_false})"
+
+    def _print_Relational(self, expr) -> str:
+        prec = PRECEDENCE["Add"]
+        lhs = self.parenthesize(expr.lhs, prec)
+        rhs = self.parenthesize(expr.rhs, prec)
+        return f"{lhs} {expr.rel_op} {rhs}"
+
+    def _print_And(self, expr) -> str:
+        return " && ".join(self._print_operand(a) for a in expr.args)
+
+    def _print_Or(self, expr) -> str:
+        return " || ".join(self._print_operand(a) for a in expr.args)
+
+    def _print_Not(self, expr) -> str:
+        return f"!({self._print(expr.args[0])})"
+
+    def _print_operand(self, arg) -> str:
+        """And/Or operands: nested boolean operators always in parentheses (WGSL requires
+        it; in C it reads better)."""
+        text = self._print(arg)
+        return f"({text})" if isinstance(arg, (sympy.And, sympy.Or)) else text
+
+    def _print_BooleanTrue(self, expr) -> str:
+        return "true"
+
+    def _print_BooleanFalse(self, expr) -> str:
+        return "false"
+
     def emptyPrinter(self, expr) -> str:  # noqa: N802 (sympy's name)
         raise ImplcError(f"'{type(expr).__name__}' cannot be printed for target {self.target}")
 

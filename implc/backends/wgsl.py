@@ -63,6 +63,10 @@ class WgslPrinter(ShaderPrinterMixin, CodePrinter):
             raise ImplcError(f"'{expr.name}' is a reserved word in WGSL and cannot be a name")
         return expr.name
 
+    def print_select(self, cond: str, if_true: str, if_false: str) -> str:
+        """WGSL has no ?:, only select(false_value, true_value, cond) (both evaluated)."""
+        return f"select({if_false}, {if_true}, {cond})"
+
     # CodePrinter's abstract hooks; implc prints single expressions, never statements.
     def _get_comment(self, text: str) -> str:
         return f"// {text}"

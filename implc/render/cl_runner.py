@@ -25,9 +25,10 @@ import numpy as np
 from ..emit import emit
 from ..errors import ToolError
 from ..methods import Constants
+from ..resources import data_dir
+from ..scene import View
 from ..surface import Surface
 from .result import RenderResult, TimedRunner
-from ..scene import View
 
 POCL = "Portable Computing Language"
 FP64 = "cl_khr_fp64"
@@ -60,9 +61,12 @@ def _pyopencl():
 
 @lru_cache(maxsize=1)
 def device() -> Device:
-    """PoCL's first device when PoCL is installed, else the first device of any platform.
+    """The first device, PoCL's first, that can build a kernel.
 
-    One per process: creating a context and loading the driver costs ~0.1 s.
+    One per process: creating a context and loading the driver costs ~0.1 s. A device
+    must build a probe kernel to be chosen: the PoCL wheel's LLVM 14 cannot name recent
+    CPUs (an AMD Zen 5 fails every build with "unknown target CPU 'generic'"), while
+    Debian's PoCL (pocl-opencl-icd, LLVM 15) picks its nearest kernel-library variant.
     """
     cl = _pyopencl()
     try:
@@ -71,12 +75,21 @@ def device() -> Device:
         raise ToolError(f"no OpenCL platform found ({err}); install pocl-binary-distribution "
                         "(run `make setup`)") from err
     platforms = sorted(platforms, key=lambda p: p.name.strip() != POCL)
+    probe = (data_dir("templates") / "opencl" / "probe.cl").read_text(encoding="utf-8")
+    failures = []
     for platform in platforms:
-        devices = platform.get_devices()
-        if devices:
-            context = cl.Context(devices=devices[:1])
-            return Device(context, cl.CommandQueue(context), devices[0])
-    raise ToolError("no OpenCL device found (install pocl-binary-distribution: `make setup`)")
+        for dev in platform.get_devices():
+            context = cl.Context(devices=[dev])
+            try:
+                with _quiet_stderr():
+                    cl.Program(context, probe).build()
+            except cl.Error as err:
+                failures.append(f"{dev.name.strip()}: {str(err).strip().splitlines()[-1]}")
+                continue
+            return Device(context, cl.CommandQueue(context), dev)
+    detail = "; ".join(failures) if failures else "none found"
+    raise ToolError(f"no OpenCL device that builds kernels ({detail}); install Debian's "
+                    "pocl-opencl-icd or pocl-binary-distribution (`make setup`)")
 
 
 @dataclass(frozen=True)

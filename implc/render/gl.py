@@ -12,8 +12,8 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import ToolError
-from .result import RenderResult, TimedRunner
 from ..scene import View
+from .result import RenderResult, TimedRunner
 
 TRIANGLES = 0x0004  # GL_TRIANGLES
 

@@ -17,8 +17,8 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import ToolError
-from .result import RenderResult, TimedRunner
 from ..scene import View
+from .result import RenderResult, TimedRunner
 
 WORKGROUP = 8  # the workgroup size (8 x 8) in templates/wgsl/program.wgsl.j2
 COLOR_FORMAT = "rgba32float"  # storage-writable in core WebGPU, and exact like GL's f4

@@ -3,6 +3,7 @@
 // Surface: Steiner
 // Equation: x^2*y^2 - x^2*z^2 - x*y*z + y^2*z^2 = 0
 // Method: hessian-approx (Eq. 4: paper)
+
 // Camera: pixel (i, j) looks along normalize(forward + ndc.x*tan(fov/2)*aspect*right
 // + ndc.y*tan(fov/2)*up), ndc = 2*gl_FragCoord.xy/u_resolution - 1 (see README).
 uniform vec2 u_resolution;   // framebuffer size in pixels
@@ -25,7 +26,18 @@ const float EPS = 0.001;
 const int MAX_STEPS = 20000;
 const int REFINE_STEPS = 10;
 
-// S(p): the surface is S = 0
+struct Ray {
+    vec3 o;  // origin of the march, s = 0
+    vec3 d;  // unit direction
+};
+
+struct Hit {
+    bool hit;  // a root was found in [t0, t1]
+    float t;  // the root; t1 when there is none
+    int steps;  // march steps taken
+};
+
+// S at the point p
 float S(vec3 p) {
     float x = p.x;
     float y = p.y;
@@ -36,7 +48,7 @@ float S(vec3 p) {
     return -x*y*z + x_2*y_2 - x_2*z_2 + y_2*z_2;
 }
 
-// grad S(p): the unnormalized normal
+// grad at the point p
 vec3 grad(vec3 p) {
     float x = p.x;
     float y = p.y;
@@ -48,7 +60,7 @@ vec3 grad(vec3 p) {
     return vec3(2.0*x*y_2 - 2.0*x*z_2 - y*z, t0*x_2 + t0*z_2 - x*z, -x*y - 2.0*x_2*z + 2.0*y_2*z);
 }
 
-// (F, F') at p along the unit direction d
+// S, dS at the point p along the unit direction d
 vec2 SD(vec3 p, vec3 d) {
     float x = p.x;
     float y = p.y;
@@ -64,7 +76,7 @@ vec2 SD(vec3 p, vec3 d) {
     return vec2(-t0*x + x_2*y_2 - x_2*z_2 + y_2*z_2, dx*(-t0 + 2.0*x*y_2 - 2.0*x*z_2) + dy*(t1*x_2 + t1*z_2 - x*z) + dz*(-x*y - 2.0*x_2*z + 2.0*y_2*z));
 }
 
-// F'(t) = grad S(p) . d
+// dS at the point p along the unit direction d
 float dS(vec3 p, vec3 d) {
     float x = p.x;
     float y = p.y;
@@ -79,41 +91,46 @@ float dS(vec3 p, vec3 d) {
     return dx*(2.0*x*y_2 - 2.0*x*z_2 - y*z) + dy*(t0*x_2 + t0*z_2 - x*z) + dz*(-x*y - 2.0*x_2*z + 2.0*y_2*z);
 }
 
-// What the method needs at a march point: (F, F', X) with X the method's extra value.
-vec3 point(vec3 p, vec3 d) {
-    // F'' ~ (F'(t + eps) - F'(t)) / eps: a finite difference of the exact F' along the ray
-    vec2 f = SD(p, d);
-    return vec3(f, (dS(p + EPS*d, d) - f.y)/EPS);
+// The ray a march runs on: o + s d.
+Ray ray_of(vec3 ro, vec3 rd) {
+    return Ray(ro, rd);
 }
 
-// Step size at the current point.
-float step_size(vec3 f, vec3 p, vec3 d) {
-    // Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b
-    float a = abs(f.x);
-    if (a <= TAU1) {
-        return abs(f.y) <= TAU3 ? 0.25*STEP : 0.5*STEP;
-    }
-    return a > TAU2 ? 2.0*STEP : STEP;
+// What the method evaluates at a march point s: (F, F', X), X its extra value.
+vec3 values_at(Ray ray, float s) {
+    vec2 e0 = SD(ray.o + s*ray.d, ray.d);
+    float e1 = dS(ray.o + (EPS + s)*ray.d, ray.d);
+    return vec3(e0.x, e0.y, (-e0.y + e1)/EPS);
 }
 
-// Does [t0, t0 + h] hold a root? f0, f1 are point() at its ends.
+// (F, F') at s, for the refinement.
+vec2 fd(Ray ray, float s) {
+    return SD(ray.o + s*ray.d, ray.d);
+}
+
+// The step length at s, from the sample f0 there.
+float step_size(Ray ray, float s, vec3 f0) {
+    return (TAU1 >= abs(f0.x) ? (TAU3 >= abs(f0.y) ? 0.25*STEP : 0.5*STEP) : (TAU2 < abs(f0.x) ? 2.0*STEP : STEP));
+}
+
+// Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
 bool root_in(vec3 f0, vec3 f1, float h) {
-    // Eq. 4 as printed: F''(t0) in both q and r, with h^2/2
-    float q = f0.x + 0.5*h*f0.y + 0.5*h*h*f0.z;
-    float r = f1.x - 0.5*h*f1.y + 0.5*h*h*f0.z;
-    float lo = min(min(f0.x, q), min(r, f1.x));
-    float hi = max(max(f0.x, q), max(r, f1.x));
-    return lo <= 0.0 && hi >= 0.0;
+    float q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
+    float r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
+    return max(f0.x, max(f1.x, max(q, r))) >= 0.0 && min(f0.x, min(f1.x, min(q, r))) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
 // or meets F' = 0 becomes the midpoint; the bracket shrinks by sign when F changes sign
 // over it (a touching, double root has no sign change: Newton is then only clamped).
-float refine(vec3 ro, vec3 rd, float a, float b, float fa, float fb) {
+float refine(Ray ray, float a0, float b0, float fa0, float fb) {
+    float a = a0;
+    float b = b0;
+    float fa = fa0;
     bool bracketed = fa*fb <= 0.0;
     float t = 0.5*(a + b);
     for (int i = 0; i < REFINE_STEPS; ++i) {
-        vec2 f = SD(ro + t*rd, rd);
+        vec2 f = fd(ray, t);
         if (bracketed) {
             if (fa*f.x <= 0.0) {
                 b = t;
@@ -124,53 +141,71 @@ float refine(vec3 ro, vec3 rd, float a, float b, float fa, float fb) {
         }
         float next = t - f.x/f.y;
         if (f.y == 0.0 || !(next >= a && next <= b)) {
-            next = bracketed ? 0.5*(a + b) : clamp(next, a, b);
+            next = (bracketed ? 0.5*(a + b) : clamp(next, a, b));
         }
         t = next;
     }
     return t;
 }
 
-// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1).
-// Start the ray near the surface (e.g. at its clip-sphere entry) to keep float32 t small.
-bool march(vec3 ro, vec3 rd, float t0, float t1, out float t, out int steps) {
+// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
+// march to the first step that may hold a root and leave the loop, then refine once.
+// (Refining inside the loop would make a SIMD group run the refinement once for every
+// distinct step at which one of its lanes finds a root.) Start the ray near the surface
+// (e.g. at its clip-sphere entry) to keep float32 t small.
+Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
+    Ray ray = ray_of(ro, rd);
     float s = t0;
-    vec3 f = point(ro + s*rd, rd);
-    steps = 0;
+    vec3 f = values_at(ray, t0);
+    float s1 = t0;
+    vec3 f1 = f;
+    bool found = false;
+    int steps = 0;
     for (int i = 0; i < MAX_STEPS; ++i) {
         if (s >= t1) {
             break;
         }
-        float s1 = min(s + step_size(f, ro + s*rd, rd), t1);
-        vec3 f1 = point(ro + s1*rd, rd);
+        s1 = min(s + step_size(ray, s, f), t1);
+        f1 = values_at(ray, s1);
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
-            t = refine(ro, rd, s, s1, f.x, f1.x);
-            return true;
+            found = true;
+            break;
         }
         s = s1;
         f = f1;
     }
-    t = t1;
-    return false;
+    float t = t1;
+    if (found) {
+        t = refine(ray, s, s1, f.x, f1.x);
+    }
+    return Hit(found, t, steps);
+}
+
+// Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
+// the root in t (t1 when there is none) and the march steps taken in steps.
+bool march(vec3 ro, vec3 rd, float t0, float t1, out float t, out int steps) {
+    Hit r = trace(ro, rd, t0, t1);
+    t = r.t;
+    steps = r.steps;
+    return r.hit;
 }
 
 // First hit of the ray ro + t rd (|rd| = 1) with S = 0 for t in [t0, t1].
 bool intersect(vec3 ro, vec3 rd, float t0, float t1, out float t) {
-    int steps;
-    vec3 start = ro + t0*rd;
-    bool hit = march(start, rd, 0.0, t1 - t0, t, steps);
-    t += t0;
-    return hit;
+    Hit r = trace(ro + t0*rd, rd, 0.0, t1 - t0);
+    t = r.t + t0;
+    return r.hit;
 }
+
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 vec3 shade(vec3 g, vec3 rd) {
     float len = length(g);
-    vec3 n = len > 0.0 ? g/len : vec3(0.0, 0.0, 1.0);
+    vec3 n = (len > 0.0 ? g/len : vec3(0.0, 0.0, 1.0));
     bool front = dot(n, rd) < 0.0;
-    vec3 base = front ? vec3(0.9, 0.62, 0.25) : vec3(0.3, 0.55, 0.9);
-    n = front ? n : -n;
+    vec3 base = (front ? vec3(0.9, 0.62, 0.25) : vec3(0.3, 0.55, 0.9));
+    n = (front ? n : -n);
     vec3 color = 0.18*base;
     {
         vec3 l = vec3(-0.17188476163102112, 0.832612442726477, 0.5265094006151227);
@@ -186,7 +221,7 @@ vec3 shade(vec3 g, vec3 rd) {
         float spec = pow(max(dot(n, h), 0.0), 48.0);
         color += vec3(0.35, 0.35, 0.4)*(diffuse*base + 0.35*spec);
     }
-    return clamp(color, 0.0, 1.0);
+    return clamp(color, vec3(0.0, 0.0, 0.0), vec3(1.0, 1.0, 1.0));
 }
 
 void main() {

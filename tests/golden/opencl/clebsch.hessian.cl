@@ -2,6 +2,7 @@
 // Surface: Clebsch cubic
 // Equation: 81*x^3 - 189*x^2*y - 189*x^2*z - 9*x^2 - 189*x*y^2 + 54*x*y*z + 126*x*y - 189*x*z^2 + 126*x*z - 9*x + 81*y^3 - 189*y^2*z - 9*y^2 - 189*y*z^2 + 126*y*z - 9*y + 81*z^3 - 9*z^2 - 9*z + 1 = 0
 // Method: hessian (Eq. 4: paper)
+
 // Precision: float
 
 // Kernel (one work-item per pixel, global size (width, height)):
@@ -25,7 +26,18 @@ __constant float TAU3 = 0.01f;
 __constant int MAX_STEPS = 20000;
 __constant int REFINE_STEPS = 10;
 
-// S(p): the surface is S = 0
+typedef struct {
+    float3 o;  // origin of the march, s = 0
+    float3 d;  // unit direction
+} Ray;
+
+typedef struct {
+    bool hit;  // a root was found in [t0, t1]
+    float t;  // the root; t1 when there is none
+    int steps;  // march steps taken
+} Hit;
+
+// S at the point p
 float S(float3 p) {
     float x = p.x;
     float y = p.y;
@@ -42,7 +54,7 @@ float S(float3 p) {
     return -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f;
 }
 
-// grad S(p): the unnormalized normal
+// grad at the point p
 float3 grad(float3 p) {
     float x = p.x;
     float y = p.y;
@@ -57,31 +69,7 @@ float3 grad(float3 p) {
     return (float3)(-t1 - t2 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z, -t1 - t3 + 54.0f*x*z - 18.0f*y + 243.0f*y_2, -t2 - t3 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f);
 }
 
-// (F, F') at p along the unit direction d
-float2 SD(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float x_3 = x*x_2;
-    float y_2 = y*y;
-    float y_3 = y*y_2;
-    float z_2 = z*z;
-    float z_3 = z*z_2;
-    float t0 = 189.0f*y_2;
-    float t1 = 189.0f*z_2;
-    float t2 = 189.0f*x_2;
-    float t3 = 378.0f*x;
-    float t4 = t1 + t3*y - 126.0f*z + 9.0f;
-    float t5 = t0 + t3*z - 126.0f*y;
-    float t6 = t2 - 126.0f*x + 378.0f*y*z;
-    return (float2)(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t5 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t6 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t5 - t6 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f));
-}
-
-// (F, F', F'') with F'' = d^T H(p) d, the exact Hessian
+// S, dS, d2S at the point p along the unit direction d
 float3 SDH(float3 p, float3 d) {
     float x = p.x;
     float y = p.y;
@@ -113,39 +101,69 @@ float3 SDH(float3 p, float3 d) {
     return (float3)(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t6 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t7 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t6 - t7 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f), dx_2*(-t3 - t8 + 486.0f*x) + 2.0f*dy*dz*(-t3 - t5 + 54.0f*x + 126.0f) + dy*t11*(-t10 + 54.0f*z + 126.0f) + dy_2*(-t8 - t9 + 486.0f*y) + dz*t11*(-t5 - t9 + 54.0f*y + 126.0f) + dz_2*(-t10 + 486.0f*z - 18.0f));
 }
 
-// What the method needs at a march point: (F, F', X) with X the method's extra value.
-float3 point(float3 p, float3 d) {
-    return SDH(p, d);
+// S, dS at the point p along the unit direction d
+float2 SD(float3 p, float3 d) {
+    float x = p.x;
+    float y = p.y;
+    float z = p.z;
+    float dx = d.x;
+    float dy = d.y;
+    float dz = d.z;
+    float x_2 = x*x;
+    float x_3 = x*x_2;
+    float y_2 = y*y;
+    float y_3 = y*y_2;
+    float z_2 = z*z;
+    float z_3 = z*z_2;
+    float t0 = 189.0f*y_2;
+    float t1 = 189.0f*z_2;
+    float t2 = 189.0f*x_2;
+    float t3 = 378.0f*x;
+    float t4 = t1 + t3*y - 126.0f*z + 9.0f;
+    float t5 = t0 + t3*z - 126.0f*y;
+    float t6 = t2 - 126.0f*x + 378.0f*y*z;
+    return (float2)(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t5 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t6 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t5 - t6 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f));
 }
 
-// Step size at the current point.
-float step_size(float3 f, float3 p, float3 d) {
-    // Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b
-    float a = fabs(f.x);
-    if (a <= TAU1) {
-        return fabs(f.y) <= TAU3 ? 0.25f*STEP : 0.5f*STEP;
-    }
-    return a > TAU2 ? 2.0f*STEP : STEP;
+// The ray a march runs on: o + s d.
+Ray ray_of(float3 ro, float3 rd) {
+    return (Ray){ro, rd};
 }
 
-// Does [t0, t0 + h] hold a root? f0, f1 are point() at its ends.
+// What the method evaluates at a march point s: (F, F', X), X its extra value.
+float3 values_at(Ray ray, float s) {
+    float3 e0 = SDH(ray.o + s*ray.d, ray.d);
+    return (float3)(e0.x, e0.y, e0.z);
+}
+
+// (F, F') at s, for the refinement.
+float2 fd(Ray ray, float s) {
+    return SD(ray.o + s*ray.d, ray.d);
+}
+
+// The step length at s, from the sample f0 there.
+float step_size(Ray ray, float s, float3 f0) {
+    return (TAU1 >= fabs(f0.x) ? (TAU3 >= fabs(f0.y) ? 0.25f*STEP : 0.5f*STEP) : (TAU2 < fabs(f0.x) ? 2.0f*STEP : STEP));
+}
+
+// Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
 bool root_in(float3 f0, float3 f1, float h) {
-    // Eq. 4 as printed: F''(t0) in both q and r, with h^2/2
-    float q = f0.x + 0.5f*h*f0.y + 0.5f*h*h*f0.z;
-    float r = f1.x - 0.5f*h*f1.y + 0.5f*h*h*f0.z;
-    float lo = fmin(fmin(f0.x, q), fmin(r, f1.x));
-    float hi = fmax(fmax(f0.x, q), fmax(r, f1.x));
-    return lo <= 0.0f && hi >= 0.0f;
+    float q = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
+    float r = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
+    return fmax(f0.x, fmax(f1.x, fmax(q, r))) >= 0.0f && fmin(f0.x, fmin(f1.x, fmin(q, r))) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
 // or meets F' = 0 becomes the midpoint; the bracket shrinks by sign when F changes sign
 // over it (a touching, double root has no sign change: Newton is then only clamped).
-float refine(float3 ro, float3 rd, float a, float b, float fa, float fb) {
+float refine(Ray ray, float a0, float b0, float fa0, float fb) {
+    float a = a0;
+    float b = b0;
+    float fa = fa0;
     bool bracketed = fa*fb <= 0.0f;
     float t = 0.5f*(a + b);
     for (int i = 0; i < REFINE_STEPS; ++i) {
-        float2 f = SD(ro + t*rd, rd);
+        float2 f = fd(ray, t);
         if (bracketed) {
             if (fa*f.x <= 0.0f) {
                 b = t;
@@ -156,69 +174,87 @@ float refine(float3 ro, float3 rd, float a, float b, float fa, float fb) {
         }
         float next = t - f.x/f.y;
         if (f.y == 0.0f || !(next >= a && next <= b)) {
-            next = bracketed ? 0.5f*(a + b) : clamp(next, a, b);
+            next = (bracketed ? 0.5f*(a + b) : clamp(next, a, b));
         }
         t = next;
     }
     return t;
 }
 
-// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1).
-// Start the ray near the surface (e.g. at its clip-sphere entry) to keep float32 t small.
-bool march(float3 ro, float3 rd, float t0, float t1, float* t, int* steps) {
+// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
+// march to the first step that may hold a root and leave the loop, then refine once.
+// (Refining inside the loop would make a SIMD group run the refinement once for every
+// distinct step at which one of its lanes finds a root.) Start the ray near the surface
+// (e.g. at its clip-sphere entry) to keep float32 t small.
+Hit trace(float3 ro, float3 rd, float t0, float t1) {
+    Ray ray = ray_of(ro, rd);
     float s = t0;
-    float3 f = point(ro + s*rd, rd);
-    *steps = 0;
+    float3 f = values_at(ray, t0);
+    float s1 = t0;
+    float3 f1 = f;
+    bool found = false;
+    int steps = 0;
     for (int i = 0; i < MAX_STEPS; ++i) {
         if (s >= t1) {
             break;
         }
-        float s1 = fmin(s + step_size(f, ro + s*rd, rd), t1);
-        float3 f1 = point(ro + s1*rd, rd);
-        *steps += 1;
+        s1 = min(s + step_size(ray, s, f), t1);
+        f1 = values_at(ray, s1);
+        steps += 1;
         if (root_in(f, f1, s1 - s)) {
-            *t = refine(ro, rd, s, s1, f.x, f1.x);
-            return true;
+            found = true;
+            break;
         }
         s = s1;
         f = f1;
     }
-    *t = t1;
-    return false;
+    float t = t1;
+    if (found) {
+        t = refine(ray, s, s1, f.x, f1.x);
+    }
+    return (Hit){found, t, steps};
+}
+
+// Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
+// the root in *t (t1 when there is none) and the march steps taken in *steps.
+bool march(float3 ro, float3 rd, float t0, float t1, float* t, int* steps) {
+    Hit r = trace(ro, rd, t0, t1);
+    *t = r.t;
+    *steps = r.steps;
+    return r.hit;
 }
 
 // First hit of the ray ro + t rd (|rd| = 1) with S = 0 for t in [t0, t1].
 bool intersect(float3 ro, float3 rd, float t0, float t1, float* t) {
-    int steps;
-    float3 start = ro + t0*rd;
-    bool hit = march(start, rd, 0.0f, t1 - t0, t, &steps);
-    *t += t0;
-    return hit;
+    Hit r = trace(ro + t0*rd, rd, 0.0f, t1 - t0);
+    *t = r.t + t0;
+    return r.hit;
 }
+
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 float3 shade(float3 g, float3 rd) {
     float len = length(g);
-    float3 n = len > 0.0f ? g/len : (float3)(0.0f, 0.0f, 1.0f);
+    float3 n = (len > 0.0f ? g/len : (float3)(0.0f, 0.0f, 1.0f));
     bool front = dot(n, rd) < 0.0f;
-    float3 base = front ? (float3)(0.9f, 0.62f, 0.25f) : (float3)(0.3f, 0.55f, 0.9f);
-    n = front ? n : -n;
+    float3 base = (front ? (float3)(0.9f, 0.62f, 0.25f) : (float3)(0.3f, 0.55f, 0.9f));
+    n = (front ? n : -n);
     float3 color = 0.18f*base;
     {
         float3 l = (float3)(0.26811953302120817f, -0.36567716232645714f, 0.89128678267175f);
         float3 h = normalize(l - rd);
-        float diffuse = fmax(dot(n, l), 0.0f);
-        float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);
+        float diffuse = max(dot(n, l), 0.0f);
+        float spec = pow(max(dot(n, h), 0.0f), 48.0f);
         color += (float3)(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
         float3 l = (float3)(-0.02342764522572268f, 0.989441106965471f, 0.1430295119411411f);
         float3 h = normalize(l - rd);
-        float diffuse = fmax(dot(n, l), 0.0f);
-        float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);
+        float diffuse = max(dot(n, l), 0.0f);
+        float spec = pow(max(dot(n, h), 0.0f), 48.0f);
         color += (float3)(0.35f, 0.35f, 0.4f)*(diffuse*base + 0.35f*spec);
     }
-    return clamp(color, 0.0f, 1.0f);
+    return clamp(color, (float3)(0.0f, 0.0f, 0.0f), (float3)(1.0f, 1.0f, 1.0f));
 }
 
 __kernel void render(float3 u_eye, float3 u_target, float3 u_up, float u_fov_y,

@@ -2,6 +2,7 @@
 // Surface: Cross-Cap
 // Equation: 4*x^2*(x^2 + y^2 + z^2 + z) + y^2*(y^2 + z^2 - 1) = 0
 // Method: hessian (Eq. 4: paper)
+
 // Precision: double (needs a device with cl_khr_fp64)
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 
@@ -26,7 +27,18 @@ __constant double TAU3 = 0.01;
 __constant int MAX_STEPS = 20000;
 __constant int REFINE_STEPS = 10;
 
-// S(p): the surface is S = 0
+typedef struct {
+    double3 o;  // origin of the march, s = 0
+    double3 d;  // unit direction
+} Ray;
+
+typedef struct {
+    bool hit;  // a root was found in [t0, t1]
+    double t;  // the root; t1 when there is none
+    int steps;  // march steps taken
+} Hit;
+
+// S at the point p
 double S(double3 p) {
     double x = p.x;
     double y = p.y;
@@ -38,7 +50,7 @@ double S(double3 p) {
     return 4.0*x_2*(t0 + x_2 + z) + y_2*(t0 - 1.0);
 }
 
-// grad S(p): the unnormalized normal
+// grad at the point p
 double3 grad(double3 p) {
     double x = p.x;
     double y = p.y;
@@ -53,28 +65,7 @@ double3 grad(double3 p) {
     return (double3)(8.0*x*(t0 + x_2 + z) + 8.0*x_3, 8.0*x_2*y + 2.0*y*(t0 - 1.0) + 2.0*y_3, t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
-// (F, F') at p along the unit direction d
-double2 SD(double3 p, double3 d) {
-    double x = p.x;
-    double y = p.y;
-    double z = p.z;
-    double dx = d.x;
-    double dy = d.y;
-    double dz = d.z;
-    double x_2 = x*x;
-    double x_3 = x*x_2;
-    double y_2 = y*y;
-    double y_3 = y*y_2;
-    double z_2 = z*z;
-    double t0 = y_2 + z_2;
-    double t1 = t0 - 1.0;
-    double t2 = t0 + x_2 + z;
-    double t3 = 4.0*x_2;
-    double t4 = 2.0*z;
-    return (double2)(t1*y_2 + t2*t3, dx*(8.0*t2*x + 8.0*x_3) + dy*(2.0*t1*y + 8.0*x_2*y + 2.0*y_3) + dz*(t3*(t4 + 1.0) + t4*y_2));
-}
-
-// (F, F', F'') with F'' = d^T H(p) d, the exact Hessian
+// S, dS, d2S at the point p along the unit direction d
 double3 SDH(double3 p, double3 d) {
     double x = p.x;
     double y = p.y;
@@ -103,39 +94,66 @@ double3 SDH(double3 p, double3 d) {
     return (double3)(t1*y_2 + t2*t3, dx*(8.0*t2*x + 8.0*x_3) + dy*(2.0*t1*y + t6*y + 2.0*y_3) + dz*(t3*t5 + t4*y_2), dx_2*(t9 + 48.0*x_2 + 8.0*y_2 + 8.0*z_2) + dy_2*(t6 + 12.0*y_2 + 2.0*z_2 - 2.0) + 16.0*dz*t5*t8 + dz*t7*t9 + dz_2*(t6 + 2.0*y_2) + 32.0*t7*t8);
 }
 
-// What the method needs at a march point: (F, F', X) with X the method's extra value.
-double3 point(double3 p, double3 d) {
-    return SDH(p, d);
+// S, dS at the point p along the unit direction d
+double2 SD(double3 p, double3 d) {
+    double x = p.x;
+    double y = p.y;
+    double z = p.z;
+    double dx = d.x;
+    double dy = d.y;
+    double dz = d.z;
+    double x_2 = x*x;
+    double x_3 = x*x_2;
+    double y_2 = y*y;
+    double y_3 = y*y_2;
+    double z_2 = z*z;
+    double t0 = y_2 + z_2;
+    double t1 = t0 - 1.0;
+    double t2 = t0 + x_2 + z;
+    double t3 = 4.0*x_2;
+    double t4 = 2.0*z;
+    return (double2)(t1*y_2 + t2*t3, dx*(8.0*t2*x + 8.0*x_3) + dy*(2.0*t1*y + 8.0*x_2*y + 2.0*y_3) + dz*(t3*(t4 + 1.0) + t4*y_2));
 }
 
-// Step size at the current point.
-double step_size(double3 f, double3 p, double3 d) {
-    // Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b
-    double a = fabs(f.x);
-    if (a <= TAU1) {
-        return fabs(f.y) <= TAU3 ? 0.25*STEP : 0.5*STEP;
-    }
-    return a > TAU2 ? 2.0*STEP : STEP;
+// The ray a march runs on: o + s d.
+Ray ray_of(double3 ro, double3 rd) {
+    return (Ray){ro, rd};
 }
 
-// Does [t0, t0 + h] hold a root? f0, f1 are point() at its ends.
+// What the method evaluates at a march point s: (F, F', X), X its extra value.
+double3 values_at(Ray ray, double s) {
+    double3 e0 = SDH(ray.o + s*ray.d, ray.d);
+    return (double3)(e0.x, e0.y, e0.z);
+}
+
+// (F, F') at s, for the refinement.
+double2 fd(Ray ray, double s) {
+    return SD(ray.o + s*ray.d, ray.d);
+}
+
+// The step length at s, from the sample f0 there.
+double step_size(Ray ray, double s, double3 f0) {
+    return (TAU1 >= fabs(f0.x) ? (TAU3 >= fabs(f0.y) ? 0.25*STEP : 0.5*STEP) : (TAU2 < fabs(f0.x) ? 2.0*STEP : STEP));
+}
+
+// Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
 bool root_in(double3 f0, double3 f1, double h) {
-    // Eq. 4 as printed: F''(t0) in both q and r, with h^2/2
-    double q = f0.x + 0.5*h*f0.y + 0.5*h*h*f0.z;
-    double r = f1.x - 0.5*h*f1.y + 0.5*h*h*f0.z;
-    double lo = fmin(fmin(f0.x, q), fmin(r, f1.x));
-    double hi = fmax(fmax(f0.x, q), fmax(r, f1.x));
-    return lo <= 0.0 && hi >= 0.0;
+    double q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
+    double r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
+    return fmax(f0.x, fmax(f1.x, fmax(q, r))) >= 0.0 && fmin(f0.x, fmin(f1.x, fmin(q, r))) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
 // or meets F' = 0 becomes the midpoint; the bracket shrinks by sign when F changes sign
 // over it (a touching, double root has no sign change: Newton is then only clamped).
-double refine(double3 ro, double3 rd, double a, double b, double fa, double fb) {
+double refine(Ray ray, double a0, double b0, double fa0, double fb) {
+    double a = a0;
+    double b = b0;
+    double fa = fa0;
     bool bracketed = fa*fb <= 0.0;
     double t = 0.5*(a + b);
     for (int i = 0; i < REFINE_STEPS; ++i) {
-        double2 f = SD(ro + t*rd, rd);
+        double2 f = fd(ray, t);
         if (bracketed) {
             if (fa*f.x <= 0.0) {
                 b = t;
@@ -146,69 +164,87 @@ double refine(double3 ro, double3 rd, double a, double b, double fa, double fb) 
         }
         double next = t - f.x/f.y;
         if (f.y == 0.0 || !(next >= a && next <= b)) {
-            next = bracketed ? 0.5*(a + b) : clamp(next, a, b);
+            next = (bracketed ? 0.5*(a + b) : clamp(next, a, b));
         }
         t = next;
     }
     return t;
 }
 
-// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1).
-// Start the ray near the surface (e.g. at its clip-sphere entry) to keep float32 t small.
-bool march(double3 ro, double3 rd, double t0, double t1, double* t, int* steps) {
+// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
+// march to the first step that may hold a root and leave the loop, then refine once.
+// (Refining inside the loop would make a SIMD group run the refinement once for every
+// distinct step at which one of its lanes finds a root.) Start the ray near the surface
+// (e.g. at its clip-sphere entry) to keep float32 t small.
+Hit trace(double3 ro, double3 rd, double t0, double t1) {
+    Ray ray = ray_of(ro, rd);
     double s = t0;
-    double3 f = point(ro + s*rd, rd);
-    *steps = 0;
+    double3 f = values_at(ray, t0);
+    double s1 = t0;
+    double3 f1 = f;
+    bool found = false;
+    int steps = 0;
     for (int i = 0; i < MAX_STEPS; ++i) {
         if (s >= t1) {
             break;
         }
-        double s1 = fmin(s + step_size(f, ro + s*rd, rd), t1);
-        double3 f1 = point(ro + s1*rd, rd);
-        *steps += 1;
+        s1 = min(s + step_size(ray, s, f), t1);
+        f1 = values_at(ray, s1);
+        steps += 1;
         if (root_in(f, f1, s1 - s)) {
-            *t = refine(ro, rd, s, s1, f.x, f1.x);
-            return true;
+            found = true;
+            break;
         }
         s = s1;
         f = f1;
     }
-    *t = t1;
-    return false;
+    double t = t1;
+    if (found) {
+        t = refine(ray, s, s1, f.x, f1.x);
+    }
+    return (Hit){found, t, steps};
+}
+
+// Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
+// the root in *t (t1 when there is none) and the march steps taken in *steps.
+bool march(double3 ro, double3 rd, double t0, double t1, double* t, int* steps) {
+    Hit r = trace(ro, rd, t0, t1);
+    *t = r.t;
+    *steps = r.steps;
+    return r.hit;
 }
 
 // First hit of the ray ro + t rd (|rd| = 1) with S = 0 for t in [t0, t1].
 bool intersect(double3 ro, double3 rd, double t0, double t1, double* t) {
-    int steps;
-    double3 start = ro + t0*rd;
-    bool hit = march(start, rd, 0.0, t1 - t0, t, &steps);
-    *t += t0;
-    return hit;
+    Hit r = trace(ro + t0*rd, rd, 0.0, t1 - t0);
+    *t = r.t + t0;
+    return r.hit;
 }
+
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 double3 shade(double3 g, double3 rd) {
     double len = length(g);
-    double3 n = len > 0.0 ? g/len : (double3)(0.0, 0.0, 1.0);
+    double3 n = (len > 0.0 ? g/len : (double3)(0.0, 0.0, 1.0));
     bool front = dot(n, rd) < 0.0;
-    double3 base = front ? (double3)(0.9, 0.62, 0.25) : (double3)(0.3, 0.55, 0.9);
-    n = front ? n : -n;
+    double3 base = (front ? (double3)(0.9, 0.62, 0.25) : (double3)(0.3, 0.55, 0.9));
+    n = (front ? n : -n);
     double3 color = 0.18*base;
     {
         double3 l = (double3)(-0.17234958115246082, 0.847855300448139, 0.5014349522904914);
         double3 h = normalize(l - rd);
-        double diffuse = fmax(dot(n, l), 0.0);
-        double spec = pow(fmax(dot(n, h), 0.0), 48.0);
+        double diffuse = max(dot(n, l), 0.0);
+        double spec = pow(max(dot(n, h), 0.0), 48.0);
         color += (double3)(0.85, 0.85, 0.85)*(diffuse*base + 0.35*spec);
     }
     {
         double3 l = (double3)(0.9970900058559551, -0.04450422508209698, -0.061894217597555194);
         double3 h = normalize(l - rd);
-        double diffuse = fmax(dot(n, l), 0.0);
-        double spec = pow(fmax(dot(n, h), 0.0), 48.0);
+        double diffuse = max(dot(n, l), 0.0);
+        double spec = pow(max(dot(n, h), 0.0), 48.0);
         color += (double3)(0.35, 0.35, 0.4)*(diffuse*base + 0.35*spec);
     }
-    return clamp(color, 0.0, 1.0);
+    return clamp(color, (double3)(0.0, 0.0, 0.0), (double3)(1.0, 1.0, 1.0));
 }
 
 __kernel void render(double3 u_eye, double3 u_target, double3 u_up, double u_fov_y,

@@ -2,6 +2,7 @@
 // Surface: Miter
 // Equation: 4*x^2*(x^2 + y^2 + z^2) - y^2*(-y^2 - z^2 + 1) = 0
 // Method: hessian (Eq. 4: paper)
+
 // Precision: float
 
 // Drop-in functions (no kernel): paste into an OpenCL C program and call them from your
@@ -22,7 +23,18 @@ __constant float MITER_TAU3 = 0.01f;
 __constant int MITER_MAX_STEPS = 20000;
 __constant int MITER_REFINE_STEPS = 10;
 
-// S(p): the surface is S = 0
+typedef struct {
+    float3 o;  // origin of the march, s = 0
+    float3 d;  // unit direction
+} miter_Ray;
+
+typedef struct {
+    bool hit;  // a root was found in [t0, t1]
+    float t;  // the root; t1 when there is none
+    int steps;  // march steps taken
+} miter_Hit;
+
+// S at the point p
 float miter_S(float3 p) {
     float x = p.x;
     float y = p.y;
@@ -34,7 +46,7 @@ float miter_S(float3 p) {
     return 4.0f*x_2*(t0 + x_2) - y_2*(1.0f - t0);
 }
 
-// grad S(p): the unnormalized normal
+// grad at the point p
 float3 miter_grad(float3 p) {
     float x = p.x;
     float y = p.y;
@@ -49,27 +61,7 @@ float3 miter_grad(float3 p) {
     return (float3)(8.0f*x*(t0 + x_2) + 8.0f*x_3, t1*y - 2.0f*y*(1.0f - t0) + 2.0f*y_3, t1*z + 2.0f*y_2*z);
 }
 
-// (F, F') at p along the unit direction d
-float2 miter_SD(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float x_3 = x*x_2;
-    float y_2 = y*y;
-    float y_3 = y*y_2;
-    float z_2 = z*z;
-    float t0 = y_2 + z_2;
-    float t1 = t0 + x_2;
-    float t2 = 1.0f - t0;
-    float t3 = 8.0f*x_2;
-    return (float2)(4.0f*t1*x_2 - t2*y_2, dx*(8.0f*t1*x + 8.0f*x_3) + dy*(-2.0f*t2*y + t3*y + 2.0f*y_3) + dz*(t3*z + 2.0f*y_2*z));
-}
-
-// (F, F', F'') with F'' = d^T H(p) d, the exact Hessian
+// S, dS, d2S at the point p along the unit direction d
 float3 miter_SDH(float3 p, float3 d) {
     float x = p.x;
     float y = p.y;
@@ -96,39 +88,65 @@ float3 miter_SDH(float3 p, float3 d) {
     return (float3)(4.0f*t1*x_2 - t2*y_2, dx*(8.0f*t1*x + 8.0f*x_3) + dy*(-2.0f*t2*y + t3*y + 2.0f*y_3) + dz*(t3*z + t4*z), dx_2*(48.0f*x_2 + 8.0f*y_2 + 8.0f*z_2) + dy_2*(t3 + 12.0f*y_2 + 2.0f*z_2 - 2.0f) + dz_2*(t3 + t4) + t5*t6 + 8.0f*t5*t7 + t6*t7);
 }
 
-// What the method needs at a march point: (F, F', X) with X the method's extra value.
-float3 miter_point(float3 p, float3 d) {
-    return miter_SDH(p, d);
+// S, dS at the point p along the unit direction d
+float2 miter_SD(float3 p, float3 d) {
+    float x = p.x;
+    float y = p.y;
+    float z = p.z;
+    float dx = d.x;
+    float dy = d.y;
+    float dz = d.z;
+    float x_2 = x*x;
+    float x_3 = x*x_2;
+    float y_2 = y*y;
+    float y_3 = y*y_2;
+    float z_2 = z*z;
+    float t0 = y_2 + z_2;
+    float t1 = t0 + x_2;
+    float t2 = 1.0f - t0;
+    float t3 = 8.0f*x_2;
+    return (float2)(4.0f*t1*x_2 - t2*y_2, dx*(8.0f*t1*x + 8.0f*x_3) + dy*(-2.0f*t2*y + t3*y + 2.0f*y_3) + dz*(t3*z + 2.0f*y_2*z));
 }
 
-// Step size at the current point.
-float miter_step_size(float3 f, float3 p, float3 d) {
-    // Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b
-    float a = fabs(f.x);
-    if (a <= MITER_TAU1) {
-        return fabs(f.y) <= MITER_TAU3 ? 0.25f*MITER_STEP : 0.5f*MITER_STEP;
-    }
-    return a > MITER_TAU2 ? 2.0f*MITER_STEP : MITER_STEP;
+// The ray a march runs on: o + s d.
+miter_Ray miter_ray_of(float3 ro, float3 rd) {
+    return (miter_Ray){ro, rd};
 }
 
-// Does [t0, t0 + h] hold a root? f0, f1 are point() at its ends.
+// What the method evaluates at a march point s: (F, F', X), X its extra value.
+float3 miter_values_at(miter_Ray ray, float s) {
+    float3 e0 = miter_SDH(ray.o + s*ray.d, ray.d);
+    return (float3)(e0.x, e0.y, e0.z);
+}
+
+// (F, F') at s, for the refinement.
+float2 miter_fd(miter_Ray ray, float s) {
+    return miter_SD(ray.o + s*ray.d, ray.d);
+}
+
+// The step length at s, from the sample f0 there.
+float miter_step_size(miter_Ray ray, float s, float3 f0) {
+    return (MITER_TAU1 >= fabs(f0.x) ? (MITER_TAU3 >= fabs(f0.y) ? 0.25f*MITER_STEP : 0.5f*MITER_STEP) : (MITER_TAU2 < fabs(f0.x) ? 2.0f*MITER_STEP : MITER_STEP));
+}
+
+// Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
 bool miter_root_in(float3 f0, float3 f1, float h) {
-    // Eq. 4 as printed: F''(t0) in both q and r, with h^2/2
-    float q = f0.x + 0.5f*h*f0.y + 0.5f*h*h*f0.z;
-    float r = f1.x - 0.5f*h*f1.y + 0.5f*h*h*f0.z;
-    float lo = fmin(fmin(f0.x, q), fmin(r, f1.x));
-    float hi = fmax(fmax(f0.x, q), fmax(r, f1.x));
-    return lo <= 0.0f && hi >= 0.0f;
+    float q = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
+    float r = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
+    return fmax(f0.x, fmax(f1.x, fmax(q, r))) >= 0.0f && fmin(f0.x, fmin(f1.x, fmin(q, r))) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
 // or meets F' = 0 becomes the midpoint; the bracket shrinks by sign when F changes sign
 // over it (a touching, double root has no sign change: Newton is then only clamped).
-float miter_refine(float3 ro, float3 rd, float a, float b, float fa, float fb) {
+float miter_refine(miter_Ray ray, float a0, float b0, float fa0, float fb) {
+    float a = a0;
+    float b = b0;
+    float fa = fa0;
     bool bracketed = fa*fb <= 0.0f;
     float t = 0.5f*(a + b);
     for (int i = 0; i < MITER_REFINE_STEPS; ++i) {
-        float2 f = miter_SD(ro + t*rd, rd);
+        float2 f = miter_fd(ray, t);
         if (bracketed) {
             if (fa*f.x <= 0.0f) {
                 b = t;
@@ -139,67 +157,85 @@ float miter_refine(float3 ro, float3 rd, float a, float b, float fa, float fb) {
         }
         float next = t - f.x/f.y;
         if (f.y == 0.0f || !(next >= a && next <= b)) {
-            next = bracketed ? 0.5f*(a + b) : clamp(next, a, b);
+            next = (bracketed ? 0.5f*(a + b) : clamp(next, a, b));
         }
         t = next;
     }
     return t;
 }
 
-// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1).
-// Start the ray near the surface (e.g. at its clip-sphere entry) to keep float32 t small.
-bool miter_march(float3 ro, float3 rd, float t0, float t1, float* t, int* steps) {
+// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
+// march to the first step that may hold a root and leave the loop, then refine once.
+// (Refining inside the loop would make a SIMD group run the refinement once for every
+// distinct step at which one of its lanes finds a root.) Start the ray near the surface
+// (e.g. at its clip-sphere entry) to keep float32 t small.
+miter_Hit miter_trace(float3 ro, float3 rd, float t0, float t1) {
+    miter_Ray ray = miter_ray_of(ro, rd);
     float s = t0;
-    float3 f = miter_point(ro + s*rd, rd);
-    *steps = 0;
+    float3 f = miter_values_at(ray, t0);
+    float s1 = t0;
+    float3 f1 = f;
+    bool found = false;
+    int steps = 0;
     for (int i = 0; i < MITER_MAX_STEPS; ++i) {
         if (s >= t1) {
             break;
         }
-        float s1 = fmin(s + miter_step_size(f, ro + s*rd, rd), t1);
-        float3 f1 = miter_point(ro + s1*rd, rd);
-        *steps += 1;
+        s1 = min(s + miter_step_size(ray, s, f), t1);
+        f1 = miter_values_at(ray, s1);
+        steps += 1;
         if (miter_root_in(f, f1, s1 - s)) {
-            *t = miter_refine(ro, rd, s, s1, f.x, f1.x);
-            return true;
+            found = true;
+            break;
         }
         s = s1;
         f = f1;
     }
-    *t = t1;
-    return false;
+    float t = t1;
+    if (found) {
+        t = miter_refine(ray, s, s1, f.x, f1.x);
+    }
+    return (miter_Hit){found, t, steps};
+}
+
+// Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
+// the root in *t (t1 when there is none) and the march steps taken in *steps.
+bool miter_march(float3 ro, float3 rd, float t0, float t1, float* t, int* steps) {
+    miter_Hit r = miter_trace(ro, rd, t0, t1);
+    *t = r.t;
+    *steps = r.steps;
+    return r.hit;
 }
 
 // First hit of the ray ro + t rd (|rd| = 1) with S = 0 for t in [t0, t1].
 bool miter_intersect(float3 ro, float3 rd, float t0, float t1, float* t) {
-    int steps;
-    float3 start = ro + t0*rd;
-    bool hit = miter_march(start, rd, 0.0f, t1 - t0, t, &steps);
-    *t += t0;
-    return hit;
+    miter_Hit r = miter_trace(ro + t0*rd, rd, 0.0f, t1 - t0);
+    *t = r.t + t0;
+    return r.hit;
 }
+
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 float3 miter_shade(float3 g, float3 rd) {
     float len = length(g);
-    float3 n = len > 0.0f ? g/len : (float3)(0.0f, 0.0f, 1.0f);
+    float3 n = (len > 0.0f ? g/len : (float3)(0.0f, 0.0f, 1.0f));
     bool front = dot(n, rd) < 0.0f;
-    float3 base = front ? (float3)(0.9f, 0.62f, 0.25f) : (float3)(0.3f, 0.55f, 0.9f);
-    n = front ? n : -n;
+    float3 base = (front ? (float3)(0.9f, 0.62f, 0.25f) : (float3)(0.3f, 0.55f, 0.9f));
+    n = (front ? n : -n);
     float3 color = 0.18f*base;
     {
         float3 l = (float3)(-0.17188476163102112f, 0.832612442726477f, 0.5265094006151227f);
         float3 h = normalize(l - rd);
-        float diffuse = fmax(dot(n, l), 0.0f);
-        float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);
+        float diffuse = max(dot(n, l), 0.0f);
+        float spec = pow(max(dot(n, h), 0.0f), 48.0f);
         color += (float3)(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
         float3 l = (float3)(0.997111254924301f, -0.07479896173655665f, -0.013200781280615852f);
         float3 h = normalize(l - rd);
-        float diffuse = fmax(dot(n, l), 0.0f);
-        float spec = pow(fmax(dot(n, h), 0.0f), 48.0f);
+        float diffuse = max(dot(n, l), 0.0f);
+        float spec = pow(max(dot(n, h), 0.0f), 48.0f);
         color += (float3)(0.35f, 0.35f, 0.4f)*(diffuse*base + 0.35f*spec);
     }
-    return clamp(color, 0.0f, 1.0f);
+    return clamp(color, (float3)(0.0f, 0.0f, 0.0f), (float3)(1.0f, 1.0f, 1.0f));
 }

@@ -3,6 +3,7 @@
 // Equation: 81*x^3 - 189*x^2*y - 189*x^2*z - 9*x^2 - 189*x*y^2 + 54*x*y*z + 126*x*y - 189*x*z^2 + 126*x*z - 9*x + 81*y^3 - 189*y^2*z - 9*y^2 - 189*y*z^2 + 126*y*z - 9*y + 81*z^3 - 9*z^2 - 9*z + 1 = 0
 // Method: hessian (Eq. 4: paper)
 
+
 // Compute shader: one invocation per pixel, workgroups of 8 x 8; dispatch
 // (ceil(W/8), ceil(H/8), 1). Pixel (i, j) = global_invocation_id.xy, row j from the top:
 // ndc = (2(i + 0.5)/W - 1, 1 - 2(j + 0.5)/H) (see README "Camera and pixels").
@@ -34,14 +35,18 @@ const TAU3: f32 = 0.01f;
 const MAX_STEPS: i32 = 20000;
 const REFINE_STEPS: i32 = 10;
 
-// What march and intersect return (WGSL has no `out` parameters).
+struct Ray {
+    o: vec3<f32>,  // origin of the march, s = 0
+    d: vec3<f32>,  // unit direction
+}
+
 struct Hit {
-    hit: bool,   // a root was found in [t0, t1]
-    t: f32,      // the root; t1 when there is none
+    hit: bool,  // a root was found in [t0, t1]
+    t: f32,  // the root; t1 when there is none
     steps: i32,  // march steps taken
 }
 
-// S(p): the surface is S = 0
+// S at the point p
 fn S(p: vec3<f32>) -> f32 {
     let x: f32 = p.x;
     let y: f32 = p.y;
@@ -58,7 +63,7 @@ fn S(p: vec3<f32>) -> f32 {
     return -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f;
 }
 
-// grad S(p): the unnormalized normal
+// grad at the point p
 fn grad(p: vec3<f32>) -> vec3<f32> {
     let x: f32 = p.x;
     let y: f32 = p.y;
@@ -73,31 +78,7 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(-t1 - t2 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z, -t1 - t3 + 54.0f*x*z - 18.0f*y + 243.0f*y_2, -t2 - t3 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f);
 }
 
-// (F, F') at p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let x_3: f32 = x*x_2;
-    let y_2: f32 = y*y;
-    let y_3: f32 = y*y_2;
-    let z_2: f32 = z*z;
-    let z_3: f32 = z*z_2;
-    let t0: f32 = 189.0f*y_2;
-    let t1: f32 = 189.0f*z_2;
-    let t2: f32 = 189.0f*x_2;
-    let t3: f32 = 378.0f*x;
-    let t4: f32 = t1 + t3*y - 126.0f*z + 9.0f;
-    let t5: f32 = t0 + t3*z - 126.0f*y;
-    let t6: f32 = t2 - 126.0f*x + 378.0f*y*z;
-    return vec2<f32>(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t5 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t6 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t5 - t6 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f));
-}
-
-// (F, F', F'') with F'' = d^T H(p) d, the exact Hessian
+// S, dS, d2S at the point p along the unit direction d
 fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let x: f32 = p.x;
     let y: f32 = p.y;
@@ -129,53 +110,79 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t6 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t7 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t6 - t7 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f), dx_2*(-t3 - t8 + 486.0f*x) + 2.0f*dy*dz*(-t3 - t5 + 54.0f*x + 126.0f) + dy*t11*(-t10 + 54.0f*z + 126.0f) + dy_2*(-t8 - t9 + 486.0f*y) + dz*t11*(-t5 - t9 + 54.0f*y + 126.0f) + dz_2*(-t10 + 486.0f*z - 18.0f));
 }
 
-// What the method needs at a march point: (F, F', X) with X the method's extra value.
-fn point(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    return SDH(p, d);
+// S, dS at the point p along the unit direction d
+fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+    let x: f32 = p.x;
+    let y: f32 = p.y;
+    let z: f32 = p.z;
+    let dx: f32 = d.x;
+    let dy: f32 = d.y;
+    let dz: f32 = d.z;
+    let x_2: f32 = x*x;
+    let x_3: f32 = x*x_2;
+    let y_2: f32 = y*y;
+    let y_3: f32 = y*y_2;
+    let z_2: f32 = z*z;
+    let z_3: f32 = z*z_2;
+    let t0: f32 = 189.0f*y_2;
+    let t1: f32 = 189.0f*z_2;
+    let t2: f32 = 189.0f*x_2;
+    let t3: f32 = 378.0f*x;
+    let t4: f32 = t1 + t3*y - 126.0f*z + 9.0f;
+    let t5: f32 = t0 + t3*z - 126.0f*y;
+    let t6: f32 = t2 - 126.0f*x + 378.0f*y*z;
+    return vec2<f32>(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t5 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t6 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t5 - t6 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f));
 }
 
-// Step size at the current point.
-fn step_size(f: vec3<f32>, p: vec3<f32>, d: vec3<f32>) -> f32 {
-    // Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b
-    let a = abs(f.x);
-    if a <= TAU1 {
-        return select(0.5f*STEP, 0.25f*STEP, abs(f.y) <= TAU3);
-    }
-    return select(STEP, 2.0f*STEP, a > TAU2);
+// The ray a march runs on: o + s d.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
+    return Ray(ro, rd);
 }
 
-// Does [t0, t0 + h] hold a root? f0, f1 are point() at its ends.
+// What the method evaluates at a march point s: (F, F', X), X its extra value.
+fn values_at(ray: Ray, s: f32) -> vec3<f32> {
+    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
+    return vec3<f32>(e0.x, e0.y, e0.z);
+}
+
+// (F, F') at s, for the refinement.
+fn fd(ray: Ray, s: f32) -> vec2<f32> {
+    return SD(ray.o + s*ray.d, ray.d);
+}
+
+// The step length at s, from the sample f0 there.
+fn step_size(ray: Ray, s: f32, f0: vec3<f32>) -> f32 {
+    return select(select(STEP, 2.0f*STEP, TAU2 < abs(f0.x)), select(0.5f*STEP, 0.25f*STEP, TAU3 >= abs(f0.y)), TAU1 >= abs(f0.x));
+}
+
+// Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
 fn root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
-    // Eq. 4 as printed: F''(t0) in both q and r, with h^2/2
-    let q = f0.x + 0.5f*h*f0.y + 0.5f*h*h*f0.z;
-    let r = f1.x - 0.5f*h*f1.y + 0.5f*h*h*f0.z;
-    let lo = min(min(f0.x, q), min(r, f1.x));
-    let hi = max(max(f0.x, q), max(r, f1.x));
-    return lo <= 0.0f && hi >= 0.0f;
+    let q: f32 = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
+    let r: f32 = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
+    return max(f0.x, max(f1.x, max(q, r))) >= 0.0f && min(f0.x, min(f1.x, min(q, r))) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
 // or meets F' = 0 becomes the midpoint; the bracket shrinks by sign when F changes sign
 // over it (a touching, double root has no sign change: Newton is then only clamped).
-// (WGSL parameters are immutable: a_in, b_in, fa_in are copied into a, b, fa.)
-fn refine(ro: vec3<f32>, rd: vec3<f32>, a_in: f32, b_in: f32, fa_in: f32, fb: f32) -> f32 {
-    var a = a_in;
-    var b = b_in;
-    var fa = fa_in;
-    let bracketed = fa*fb <= 0.0f;
-    var t = 0.5f*(a + b);
+fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
+    var a: f32 = a0;
+    var b: f32 = b0;
+    var fa: f32 = fa0;
+    let bracketed: bool = fa*fb <= 0.0f;
+    var t: f32 = 0.5f*(a + b);
     for (var i: i32 = 0; i < REFINE_STEPS; i++) {
-        let f = SD(ro + t*rd, rd);
-        if bracketed {
-            if fa*f.x <= 0.0f {
+        let f: vec2<f32> = fd(ray, t);
+        if (bracketed) {
+            if (fa*f.x <= 0.0f) {
                 b = t;
             } else {
                 a = t;
                 fa = f.x;
             }
         }
-        var next = t - f.x/f.y;
-        if f.y == 0.0f || !(next >= a && next <= b) {
+        var next: f32 = t - f.x/f.y;
+        if (f.y == 0.0f || !(next >= a && next <= b)) {
             next = select(clamp(next, a, b), 0.5f*(a + b), bracketed);
         }
         t = next;
@@ -183,61 +190,78 @@ fn refine(ro: vec3<f32>, rd: vec3<f32>, a_in: f32, b_in: f32, fa_in: f32, fb: f3
     return t;
 }
 
-// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1).
-// Start the ray near the surface (e.g. at its clip-sphere entry) to keep float32 t small.
-// Returns (hit, t, steps); t = t1 when there is no hit.
-fn march(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    var s = t0;
-    var f = point(ro + s*rd, rd);
+// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
+// march to the first step that may hold a root and leave the loop, then refine once.
+// (Refining inside the loop would make a SIMD group run the refinement once for every
+// distinct step at which one of its lanes finds a root.) Start the ray near the surface
+// (e.g. at its clip-sphere entry) to keep float32 t small.
+fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
+    let ray: Ray = ray_of(ro, rd);
+    var s: f32 = t0;
+    var f: vec3<f32> = values_at(ray, t0);
+    var s1: f32 = t0;
+    var f1: vec3<f32> = f;
+    var found: bool = false;
     var steps: i32 = 0;
     for (var i: i32 = 0; i < MAX_STEPS; i++) {
-        if s >= t1 {
+        if (s >= t1) {
             break;
         }
-        let s1 = min(s + step_size(f, ro + s*rd, rd), t1);
-        let f1 = point(ro + s1*rd, rd);
+        s1 = min(s + step_size(ray, s, f), t1);
+        f1 = values_at(ray, s1);
         steps += 1;
-        if root_in(f, f1, s1 - s) {
-            return Hit(true, refine(ro, rd, s, s1, f.x, f1.x), steps);
+        if (root_in(f, f1, s1 - s)) {
+            found = true;
+            break;
         }
         s = s1;
         f = f1;
     }
-    return Hit(false, t1, steps);
+    var t: f32 = t1;
+    if (found) {
+        t = refine(ray, s, s1, f.x, f1.x);
+    }
+    return Hit(found, t, steps);
+}
+
+// Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
+// Returns (hit, t, steps); t = t1 when there is no hit.
+fn march(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
+    return trace(ro, rd, t0, t1);
 }
 
 // First hit of the ray ro + t rd (|rd| = 1) with S = 0 for t in [t0, t1].
 // Returns (hit, t, steps) with t measured from ro, like march.
 fn intersect(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let start = ro + t0*rd;
-    var result = march(start, rd, 0.0f, t1 - t0);
+    var result = trace(ro + t0*rd, rd, 0.0f, t1 - t0);
     result.t += t0;
     return result;
 }
 
+
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 fn shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32> {
-    let len = length(g);
-    var n = select(vec3<f32>(0.0f, 0.0f, 1.0f), g/len, len > 0.0f);
-    let front = dot(n, rd) < 0.0f;
-    let base = select(vec3<f32>(0.3f, 0.55f, 0.9f), vec3<f32>(0.9f, 0.62f, 0.25f), front);
+    let len: f32 = length(g);
+    var n: vec3<f32> = select(vec3<f32>(0.0f, 0.0f, 1.0f), g/len, len > 0.0f);
+    let front: bool = dot(n, rd) < 0.0f;
+    let base: vec3<f32> = select(vec3<f32>(0.3f, 0.55f, 0.9f), vec3<f32>(0.9f, 0.62f, 0.25f), front);
     n = select(-n, n, front);
-    var color = 0.18f*base;
+    var color: vec3<f32> = 0.18f*base;
     {
-        let l = vec3<f32>(0.26811953302120817f, -0.36567716232645714f, 0.89128678267175f);
-        let h = normalize(l - rd);
-        let diffuse = max(dot(n, l), 0.0f);
-        let spec = pow(max(dot(n, h), 0.0f), 48.0f);
+        let l: vec3<f32> = vec3<f32>(0.26811953302120817f, -0.36567716232645714f, 0.89128678267175f);
+        let h: vec3<f32> = normalize(l - rd);
+        let diffuse: f32 = max(dot(n, l), 0.0f);
+        let spec: f32 = pow(max(dot(n, h), 0.0f), 48.0f);
         color += vec3<f32>(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
-        let l = vec3<f32>(-0.02342764522572268f, 0.989441106965471f, 0.1430295119411411f);
-        let h = normalize(l - rd);
-        let diffuse = max(dot(n, l), 0.0f);
-        let spec = pow(max(dot(n, h), 0.0f), 48.0f);
+        let l: vec3<f32> = vec3<f32>(-0.02342764522572268f, 0.989441106965471f, 0.1430295119411411f);
+        let h: vec3<f32> = normalize(l - rd);
+        let diffuse: f32 = max(dot(n, l), 0.0f);
+        let spec: f32 = pow(max(dot(n, h), 0.0f), 48.0f);
         color += vec3<f32>(0.35f, 0.35f, 0.4f)*(diffuse*base + 0.35f*spec);
     }
-    return clamp(color, vec3<f32>(0.0f), vec3<f32>(1.0f));
+    return clamp(color, vec3<f32>(0.0f, 0.0f, 0.0f), vec3<f32>(1.0f, 1.0f, 1.0f));
 }
 
 @compute @workgroup_size(8, 8)

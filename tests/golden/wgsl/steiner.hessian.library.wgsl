@@ -3,6 +3,7 @@
 // Equation: x^2*y^2 - x^2*z^2 - x*y*z + y^2*z^2 = 0
 // Method: hessian (Eq. 4: paper)
 
+
 // Drop-in functions (no bindings, no entry point): paste into a WGSL module. Entry points:
 //   fn steiner_S(p: vec3<f32>) -> f32            the surface is S = 0
 //   fn steiner_grad(p: vec3<f32>) -> vec3<f32>   unnormalized normal
@@ -20,14 +21,18 @@ const STEINER_TAU3: f32 = 0.01f;
 const STEINER_MAX_STEPS: i32 = 20000;
 const STEINER_REFINE_STEPS: i32 = 10;
 
-// What march and intersect return (WGSL has no `out` parameters).
+struct steiner_Ray {
+    o: vec3<f32>,  // origin of the march, s = 0
+    d: vec3<f32>,  // unit direction
+}
+
 struct steiner_Hit {
-    hit: bool,   // a root was found in [t0, t1]
-    t: f32,      // the root; t1 when there is none
+    hit: bool,  // a root was found in [t0, t1]
+    t: f32,  // the root; t1 when there is none
     steps: i32,  // march steps taken
 }
 
-// S(p): the surface is S = 0
+// S at the point p
 fn steiner_S(p: vec3<f32>) -> f32 {
     let x: f32 = p.x;
     let y: f32 = p.y;
@@ -38,7 +43,7 @@ fn steiner_S(p: vec3<f32>) -> f32 {
     return -x*y*z + x_2*y_2 - x_2*z_2 + y_2*z_2;
 }
 
-// grad S(p): the unnormalized normal
+// grad at the point p
 fn steiner_grad(p: vec3<f32>) -> vec3<f32> {
     let x: f32 = p.x;
     let y: f32 = p.y;
@@ -50,23 +55,7 @@ fn steiner_grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(2.0f*x*y_2 - 2.0f*x*z_2 - y*z, t0*x_2 + t0*z_2 - x*z, -x*y - 2.0f*x_2*z + 2.0f*y_2*z);
 }
 
-// (F, F') at p along the unit direction d
-fn steiner_SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let y_2: f32 = y*y;
-    let z_2: f32 = z*z;
-    let t0: f32 = y*z;
-    let t1: f32 = 2.0f*y;
-    return vec2<f32>(-t0*x + x_2*y_2 - x_2*z_2 + y_2*z_2, dx*(-t0 + 2.0f*x*y_2 - 2.0f*x*z_2) + dy*(t1*x_2 + t1*z_2 - x*z) + dz*(-x*y - 2.0f*x_2*z + 2.0f*y_2*z));
-}
-
-// (F, F', F'') with F'' = d^T H(p) d, the exact Hessian
+// S, dS, d2S at the point p along the unit direction d
 fn steiner_SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let x: f32 = p.x;
     let y: f32 = p.y;
@@ -89,53 +78,71 @@ fn steiner_SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(-t0*x + x_2*y_2 - x_2*z_2 + y_2*z_2, dx*(-t0 - t1*x + 2.0f*x*y_2) + dy*(t1*y - t2 + t3*y) + dz*(-t3*z - t4 + 2.0f*y_2*z), dx_2*(-t1 + 2.0f*y_2) + 2.0f*dy*dz*(-x + 4.0f*y*z) + dy*t5*(4.0f*t4 - z) + dy_2*(t1 + t3) + dz*t5*(-4.0f*t2 - y) + dz_2*(-t3 + 2.0f*y_2));
 }
 
-// What the method needs at a march point: (F, F', X) with X the method's extra value.
-fn steiner_point(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    return steiner_SDH(p, d);
+// S, dS at the point p along the unit direction d
+fn steiner_SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+    let x: f32 = p.x;
+    let y: f32 = p.y;
+    let z: f32 = p.z;
+    let dx: f32 = d.x;
+    let dy: f32 = d.y;
+    let dz: f32 = d.z;
+    let x_2: f32 = x*x;
+    let y_2: f32 = y*y;
+    let z_2: f32 = z*z;
+    let t0: f32 = y*z;
+    let t1: f32 = 2.0f*y;
+    return vec2<f32>(-t0*x + x_2*y_2 - x_2*z_2 + y_2*z_2, dx*(-t0 + 2.0f*x*y_2 - 2.0f*x*z_2) + dy*(t1*x_2 + t1*z_2 - x*z) + dz*(-x*y - 2.0f*x_2*z + 2.0f*y_2*z));
 }
 
-// Step size at the current point.
-fn steiner_step_size(f: vec3<f32>, p: vec3<f32>, d: vec3<f32>) -> f32 {
-    // Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b
-    let a = abs(f.x);
-    if a <= STEINER_TAU1 {
-        return select(0.5f*STEINER_STEP, 0.25f*STEINER_STEP, abs(f.y) <= STEINER_TAU3);
-    }
-    return select(STEINER_STEP, 2.0f*STEINER_STEP, a > STEINER_TAU2);
+// The ray a march runs on: o + s d.
+fn steiner_ray_of(ro: vec3<f32>, rd: vec3<f32>) -> steiner_Ray {
+    return steiner_Ray(ro, rd);
 }
 
-// Does [t0, t0 + h] hold a root? f0, f1 are point() at its ends.
+// What the method evaluates at a march point s: (F, F', X), X its extra value.
+fn steiner_values_at(ray: steiner_Ray, s: f32) -> vec3<f32> {
+    let e0: vec3<f32> = steiner_SDH(ray.o + s*ray.d, ray.d);
+    return vec3<f32>(e0.x, e0.y, e0.z);
+}
+
+// (F, F') at s, for the refinement.
+fn steiner_fd(ray: steiner_Ray, s: f32) -> vec2<f32> {
+    return steiner_SD(ray.o + s*ray.d, ray.d);
+}
+
+// The step length at s, from the sample f0 there.
+fn steiner_step_size(ray: steiner_Ray, s: f32, f0: vec3<f32>) -> f32 {
+    return select(select(STEINER_STEP, 2.0f*STEINER_STEP, STEINER_TAU2 < abs(f0.x)), select(0.5f*STEINER_STEP, 0.25f*STEINER_STEP, STEINER_TAU3 >= abs(f0.y)), STEINER_TAU1 >= abs(f0.x));
+}
+
+// Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
 fn steiner_root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
-    // Eq. 4 as printed: F''(t0) in both q and r, with h^2/2
-    let q = f0.x + 0.5f*h*f0.y + 0.5f*h*h*f0.z;
-    let r = f1.x - 0.5f*h*f1.y + 0.5f*h*h*f0.z;
-    let lo = min(min(f0.x, q), min(r, f1.x));
-    let hi = max(max(f0.x, q), max(r, f1.x));
-    return lo <= 0.0f && hi >= 0.0f;
+    let q: f32 = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
+    let r: f32 = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
+    return max(f0.x, max(f1.x, max(q, r))) >= 0.0f && min(f0.x, min(f1.x, min(q, r))) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
 // or meets F' = 0 becomes the midpoint; the bracket shrinks by sign when F changes sign
 // over it (a touching, double root has no sign change: Newton is then only clamped).
-// (WGSL parameters are immutable: a_in, b_in, fa_in are copied into a, b, fa.)
-fn steiner_refine(ro: vec3<f32>, rd: vec3<f32>, a_in: f32, b_in: f32, fa_in: f32, fb: f32) -> f32 {
-    var a = a_in;
-    var b = b_in;
-    var fa = fa_in;
-    let bracketed = fa*fb <= 0.0f;
-    var t = 0.5f*(a + b);
+fn steiner_refine(ray: steiner_Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
+    var a: f32 = a0;
+    var b: f32 = b0;
+    var fa: f32 = fa0;
+    let bracketed: bool = fa*fb <= 0.0f;
+    var t: f32 = 0.5f*(a + b);
     for (var i: i32 = 0; i < STEINER_REFINE_STEPS; i++) {
-        let f = steiner_SD(ro + t*rd, rd);
-        if bracketed {
-            if fa*f.x <= 0.0f {
+        let f: vec2<f32> = steiner_fd(ray, t);
+        if (bracketed) {
+            if (fa*f.x <= 0.0f) {
                 b = t;
             } else {
                 a = t;
                 fa = f.x;
             }
         }
-        var next = t - f.x/f.y;
-        if f.y == 0.0f || !(next >= a && next <= b) {
+        var next: f32 = t - f.x/f.y;
+        if (f.y == 0.0f || !(next >= a && next <= b)) {
             next = select(clamp(next, a, b), 0.5f*(a + b), bracketed);
         }
         t = next;
@@ -143,59 +150,76 @@ fn steiner_refine(ro: vec3<f32>, rd: vec3<f32>, a_in: f32, b_in: f32, fa_in: f32
     return t;
 }
 
-// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1).
-// Start the ray near the surface (e.g. at its clip-sphere entry) to keep float32 t small.
-// Returns (hit, t, steps); t = t1 when there is no hit.
-fn steiner_march(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> steiner_Hit {
-    var s = t0;
-    var f = steiner_point(ro + s*rd, rd);
+// Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
+// march to the first step that may hold a root and leave the loop, then refine once.
+// (Refining inside the loop would make a SIMD group run the refinement once for every
+// distinct step at which one of its lanes finds a root.) Start the ray near the surface
+// (e.g. at its clip-sphere entry) to keep float32 t small.
+fn steiner_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> steiner_Hit {
+    let ray: steiner_Ray = steiner_ray_of(ro, rd);
+    var s: f32 = t0;
+    var f: vec3<f32> = steiner_values_at(ray, t0);
+    var s1: f32 = t0;
+    var f1: vec3<f32> = f;
+    var found: bool = false;
     var steps: i32 = 0;
     for (var i: i32 = 0; i < STEINER_MAX_STEPS; i++) {
-        if s >= t1 {
+        if (s >= t1) {
             break;
         }
-        let s1 = min(s + steiner_step_size(f, ro + s*rd, rd), t1);
-        let f1 = steiner_point(ro + s1*rd, rd);
+        s1 = min(s + steiner_step_size(ray, s, f), t1);
+        f1 = steiner_values_at(ray, s1);
         steps += 1;
-        if steiner_root_in(f, f1, s1 - s) {
-            return steiner_Hit(true, steiner_refine(ro, rd, s, s1, f.x, f1.x), steps);
+        if (steiner_root_in(f, f1, s1 - s)) {
+            found = true;
+            break;
         }
         s = s1;
         f = f1;
     }
-    return steiner_Hit(false, t1, steps);
+    var t: f32 = t1;
+    if (found) {
+        t = steiner_refine(ray, s, s1, f.x, f1.x);
+    }
+    return steiner_Hit(found, t, steps);
+}
+
+// Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
+// Returns (hit, t, steps); t = t1 when there is no hit.
+fn steiner_march(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> steiner_Hit {
+    return steiner_trace(ro, rd, t0, t1);
 }
 
 // First hit of the ray ro + t rd (|rd| = 1) with S = 0 for t in [t0, t1].
 // Returns (hit, t, steps) with t measured from ro, like march.
 fn steiner_intersect(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> steiner_Hit {
-    let start = ro + t0*rd;
-    var result = steiner_march(start, rd, 0.0f, t1 - t0);
+    var result = steiner_trace(ro + t0*rd, rd, 0.0f, t1 - t0);
     result.t += t0;
     return result;
 }
 
+
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 fn steiner_shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32> {
-    let len = length(g);
-    var n = select(vec3<f32>(0.0f, 0.0f, 1.0f), g/len, len > 0.0f);
-    let front = dot(n, rd) < 0.0f;
-    let base = select(vec3<f32>(0.3f, 0.55f, 0.9f), vec3<f32>(0.9f, 0.62f, 0.25f), front);
+    let len: f32 = length(g);
+    var n: vec3<f32> = select(vec3<f32>(0.0f, 0.0f, 1.0f), g/len, len > 0.0f);
+    let front: bool = dot(n, rd) < 0.0f;
+    let base: vec3<f32> = select(vec3<f32>(0.3f, 0.55f, 0.9f), vec3<f32>(0.9f, 0.62f, 0.25f), front);
     n = select(-n, n, front);
-    var color = 0.18f*base;
+    var color: vec3<f32> = 0.18f*base;
     {
-        let l = vec3<f32>(-0.17188476163102112f, 0.832612442726477f, 0.5265094006151227f);
-        let h = normalize(l - rd);
-        let diffuse = max(dot(n, l), 0.0f);
-        let spec = pow(max(dot(n, h), 0.0f), 48.0f);
+        let l: vec3<f32> = vec3<f32>(-0.17188476163102112f, 0.832612442726477f, 0.5265094006151227f);
+        let h: vec3<f32> = normalize(l - rd);
+        let diffuse: f32 = max(dot(n, l), 0.0f);
+        let spec: f32 = pow(max(dot(n, h), 0.0f), 48.0f);
         color += vec3<f32>(0.85f, 0.85f, 0.85f)*(diffuse*base + 0.35f*spec);
     }
     {
-        let l = vec3<f32>(0.997111254924301f, -0.07479896173655665f, -0.013200781280615852f);
-        let h = normalize(l - rd);
-        let diffuse = max(dot(n, l), 0.0f);
-        let spec = pow(max(dot(n, h), 0.0f), 48.0f);
+        let l: vec3<f32> = vec3<f32>(0.997111254924301f, -0.07479896173655665f, -0.013200781280615852f);
+        let h: vec3<f32> = normalize(l - rd);
+        let diffuse: f32 = max(dot(n, l), 0.0f);
+        let spec: f32 = pow(max(dot(n, h), 0.0f), 48.0f);
         color += vec3<f32>(0.35f, 0.35f, 0.4f)*(diffuse*base + 0.35f*spec);
     }
-    return clamp(color, vec3<f32>(0.0f), vec3<f32>(1.0f));
+    return clamp(color, vec3<f32>(0.0f, 0.0f, 0.0f), vec3<f32>(1.0f, 1.0f, 1.0f));
 }

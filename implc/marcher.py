@@ -1,0 +1,329 @@
+"""Lower a method (data, implc/methods.py) and an evaluation form to printed code pieces.
+
+The marcher skeleton (templates/marcher.j2) is written once; what varies by method and
+evaluation form is printed here, by the target's printer:
+- `functions`: straight-line shader functions, of the point p (and direction d) or of
+  the ray and its parameter s (each one jointly CSE'd where it is a Program);
+- `ray`: the ray record's fields and how `ray_of(ro, rd)` fills them;
+- `values_at(ray, s)`: the method's (F, F', X) at a march point; `fd(ray, s)`: (F, F')
+  for the refinement;
+- `step_size(ray, s, f0)`: the step rule; `root_in(f0, f1, h)`: the root test.
+
+Evaluation forms (DESIGN.md section 2) say how a ray quantity at a ray parameter is
+computed; a method never knows which one it gets:
+- `point`: jointly CSE'd functions of p = ray.o + s*ray.d and d: `SDH(p, d)` returns
+  (F, F', F'') together;
+- `ray-poly` (polynomial S): the coefficients c_k of F(s) = S(o + s d) are computed once
+  per ray in `ray_of` and kept in the ray record; F, F', F'' at s are Horner sums over them
+  (`ray_SDH(ray, s)`), about n multiply-adds each for degree n. Quantities that are not
+  ray derivatives (the Laplacian) stay point functions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import sympy
+
+from .derive import Derivatives, polynomial_degree, ray_coefficients
+from .errors import InputError
+from .methods import (
+    CONSTANT_SYMBOLS,
+    D0,
+    D1,
+    F0,
+    F1,
+    RAY_FUNCTIONS,
+    RAY_QUANTITIES,
+    X0,
+    X1,
+    Constants,
+    Method,
+    S,
+)
+from .optimize import Program, optimize
+from .symbols import DIRECTION, POINT
+
+FORMS = ("point", "ray-poly")
+EVAL_CHOICES = ("auto", *FORMS)
+# `auto` takes ray-poly for polynomials up to this degree (docs/RESULTS.md, "Evaluation
+# forms": float32 Horner on coefficients from the clip-sphere entry measured as accurate
+# as point evaluation there, and faster at every degree measured).
+AUTO_MAX_DEGREE = 12
+
+QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
+RAY_DERIVATIVES = ("S", "dS", "d2S")  # what Horner on the ray polynomial gives
+_LETTER = {"S": "S", "dS": "D", "d2S": "H", "lap": "L"}
+_RETURN_TYPE = {1: "real", 2: "vec2", 3: "vec3"}
+_COMPONENT = ("x", "y", "z")
+REFINE_SET = ("S", "dS")
+
+
+def function_name(quantities: Sequence[str]) -> str:
+    """The point function of a quantity set: S, grad, dS, SD, SDH, SDL, ..."""
+    if len(quantities) == 1:
+        return quantities[0]
+    return "".join(_LETTER[q] for q in quantities)
+
+
+def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
+    """The evaluation form for `expr`: `point` or `ray-poly` (see AUTO_MAX_DEGREE)."""
+    if requested not in EVAL_CHOICES:
+        raise InputError(f"unknown evaluation form '{requested}'; choose from "
+                         f"{', '.join(EVAL_CHOICES)}")
+    degree = polynomial_degree(expr)
+    if requested == "ray-poly" and degree is None:
+        raise InputError("--eval ray-poly needs a polynomial surface; this one is not "
+                         "(use --eval point or auto)")
+    if requested != "auto":
+        return requested
+    return "point"  # until the accuracy of ray-poly is measured (issue 10)
+
+
+@dataclass(frozen=True)
+class ShaderFunction:
+    """One straight-line shader function."""
+
+    name: str
+    comment: str
+    params: tuple[tuple[str, str], ...]  # (abstract type, name)
+    ret: str  # abstract type of the result
+    lets: tuple[tuple[str, str, str], ...]  # (abstract type, name, printed value)
+    outputs: tuple[str, ...]  # one value, or the components of the vector returned
+
+
+@dataclass(frozen=True)
+class Code:
+    """A printed body: `lets` (abstract type, name, value) in order, then `values`."""
+
+    lets: tuple[tuple[str, str, str], ...]
+    values: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Marcher:
+    """Everything method- and form-specific the skeleton prints."""
+
+    form: str
+    functions: tuple[ShaderFunction, ...]
+    constants: tuple[tuple[str, str, str], ...]  # (abstract type, name, printed value)
+    ray_fields: tuple[tuple[str, str, str], ...]  # beyond o and d: (type, name, comment)
+    ray: Code  # lets of ray_of(ro, rd), then the extra fields' values
+    sample: Code
+    fd: Code
+    step: Code
+    root: Code
+
+
+# --- what a method evaluates where ---------------------------------------------------
+
+def _applications(expr: sympy.Basic) -> list[sympy.Expr]:
+    """Applications of ray quantities in `expr`, in a canonical order."""
+    found = {a for a in sympy.preorder_traversal(expr)
+             if isinstance(a, sympy.core.function.AppliedUndef)}
+    return sorted(found, key=sympy.default_sort_key)
+
+
+def _sample_groups(method: Method) -> dict[sympy.Expr, tuple[str, ...]]:
+    """Evaluation point -> the quantities the sample needs there (canonical order)."""
+    by_arg: dict[sympy.Expr, set[str]] = {}
+    for expr in method.sample:
+        for app in _applications(expr):
+            by_arg.setdefault(app.args[0], set()).add(RAY_QUANTITIES[app.func.__name__])
+    ordered = sorted(by_arg, key=lambda a: (a != S, sympy.default_sort_key(a)))
+    return {a: tuple(q for q in QUANTITY_ORDER if q in by_arg[a]) for a in ordered}
+
+
+def _split(quantities: tuple[str, ...], form: str) -> list[tuple[str, tuple[str, ...]]]:
+    """A quantity set as (kind, subset) calls: kind `ray` (Horner) or `point`."""
+    if form == "point":
+        return [("point", quantities)]
+    ray = tuple(q for q in quantities if q in RAY_DERIVATIVES)
+    rest = tuple(q for q in quantities if q not in RAY_DERIVATIVES)
+    return [(kind, qs) for kind, qs in (("ray", ray), ("point", rest)) if qs]
+
+
+def evaluations(method: Method, form: str) -> list[tuple[str, tuple[str, ...]]]:
+    """Every (kind, quantity set) the method's program evaluates; S and grad (residual,
+    shading, library users) first."""
+    wanted = [("point", ("S",)), ("point", ("grad",))]
+    sets = [*_sample_groups(method).values(), REFINE_SET]
+    sets += [(RAY_QUANTITIES[a.func.__name__],) for a in _applications(method.step)]
+    for quantities in sets:
+        for call in _split(quantities, form):
+            if call not in wanted:
+                wanted.append(call)
+    return wanted
+
+
+def point_sets(method: Method, form: str = "point") -> tuple[tuple[str, ...], ...]:
+    return tuple(q for kind, q in evaluations(method, form) if kind == "point")
+
+
+# --- derivation (cached: emit asks for the same programs for every target) -----------
+
+def build_programs(expr: sympy.Expr, sets: tuple[tuple[str, ...], ...],
+                   max_derived: int) -> dict[str, Program]:
+    """The optimized Program of each point quantity set."""
+    return dict(_build_programs(expr, sets, max_derived))
+
+
+@lru_cache(maxsize=64)
+def _build_programs(expr, sets, max_derived) -> tuple[tuple[str, Program], ...]:
+    derivatives = Derivatives(expr, max_derived)
+    result = []
+    for quantities in sets:
+        outputs = [e for q in quantities for e in derivatives.quantity(q)]
+        directional = any(q in ("dS", "d2S") for q in quantities)
+        result.append((function_name(quantities),
+                       optimize(outputs, POINT + DIRECTION if directional else POINT)))
+    return tuple(result)
+
+
+@lru_cache(maxsize=32)
+def coefficient_program(expr: sympy.Expr) -> Program:
+    """The ray polynomial's coefficients c_0..c_n from (o, d), jointly CSE'd."""
+    coefficients = ray_coefficients(expr)
+    if coefficients is None:
+        raise InputError("the ray-poly form needs a polynomial surface")
+    return optimize(list(coefficients), POINT + DIRECTION)
+
+
+# --- printing ------------------------------------------------------------------------
+
+def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, printer,
+          prefix: str, max_derived: int) -> Marcher:
+    """Print the method's pieces in `form` with `printer`; global names start with
+    `prefix`."""
+    const_names = {c: sympy.Symbol(prefix.upper() + c.name, real=True)
+                   for c in CONSTANT_SYMBOLS}
+
+    def show(expr: sympy.Basic) -> str:
+        return printer.doprint(expr.xreplace(const_names))
+
+    wanted = evaluations(method, form)
+    programs = build_programs(expr, point_sets(method, form), max_derived)
+    functions = [_point_function(name, program, printer) for name, program in programs.items()]
+    ray_fields: tuple[tuple[str, str, str], ...] = ()
+    ray = Code((), ())
+    if form == "ray-poly":
+        coefficients = coefficient_program(expr)
+        n = len(coefficients.outputs) - 1
+        ray_fields, ray = _ray_setup(coefficients, printer)
+        functions += [_horner_function(q, n, printer) for kind, q in wanted if kind == "ray"]
+    by_name = {f.name: f for f in functions}
+
+    def call(kind: str, quantities: tuple[str, ...], arg: sympy.Expr) -> str:
+        at = f"({show(arg)})" if arg.is_Add else show(arg)
+        if kind == "ray":
+            return f"{prefix}{_ray_name(quantities)}(ray, {show(arg)})"
+        fn = by_name[function_name(quantities)]
+        args = [f"ray.o + {at}*ray.d", "ray.d"][: len(fn.params)]
+        return f"{prefix}{fn.name}({', '.join(args)})"
+
+    def calls(quantities: tuple[str, ...], arg: sympy.Expr, stem: str, lets: list,
+              replace: dict) -> None:
+        for kind, qs in _split(quantities, form):
+            name = f"{stem}{len(lets)}"
+            lets.append((_RETURN_TYPE[len(qs)], name, call(kind, qs, arg)))
+            for i, q in enumerate(qs):
+                part = name if len(qs) == 1 else f"{name}.{_COMPONENT[i]}"
+                replace[_apply(q, arg)] = _sym(part)
+
+    lets: list = []
+    replace: dict = {}
+    for arg, group in _sample_groups(method).items():
+        calls(group, arg, "e", lets, replace)
+    sample = Code(tuple(lets), tuple(show(e.xreplace(replace)) for e in method.sample))
+    kind, _ = _split(REFINE_SET, form)[0]
+    fd = Code((), (call(kind, REFINE_SET, S),))
+
+    # step rule: a ray quantity in it is evaluated inline, on the branch that reads it
+    ends0 = {F0: _sym("f0.x"), D0: _sym("f0.y"), X0: _sym("f0.z")}
+    ends1 = {F1: _sym("f1.x"), D1: _sym("f1.y"), X1: _sym("f1.z")}
+    inline = {}
+    for app in _applications(method.step):
+        single = (RAY_QUANTITIES[app.func.__name__],)
+        inline[app] = _sym(call(_split(single, form)[0][0], single, app.args[0]))
+    step = Code((), (show(method.step.xreplace({**ends0, **inline})),))
+
+    rule = method.root_rule(constants.taylor2)
+    ends = {**ends0, **ends1}
+    root = Code(tuple(("real", s.name, show(v.xreplace(ends))) for s, v in rule.lets),
+                (show(rule.value.xreplace(ends)),))
+
+    used = set().union(*(e.free_symbols for e in (*method.sample, method.step, rule.value,
+                                                    *(v for _, v in rule.lets))))
+    values = constants.values()
+    printed = tuple(("real", const_names[c].name, printer.float_literal(values[c]))
+                    for c in CONSTANT_SYMBOLS if c in used)
+    printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),
+                ("int", prefix.upper() + "REFINE_STEPS", str(int(constants.refine_steps))))
+    return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root)
+
+
+def _sym(name: str) -> sympy.Symbol:
+    return sympy.Symbol(name, real=True)
+
+
+def _apply(quantity: str, arg: sympy.Expr) -> sympy.Expr:
+    fn = next(f for f in RAY_FUNCTIONS if RAY_QUANTITIES[f.__name__] == quantity)
+    return fn(arg)
+
+
+def _ray_name(quantities: tuple[str, ...]) -> str:
+    return "ray_" + function_name(quantities)
+
+
+def _point_function(name: str, program: Program, printer) -> ShaderFunction:
+    directional = len(program.inputs) == 6
+    params = (("vec3", "p"), ("vec3", "d")) if directional else (("vec3", "p"),)
+    lets = [("real", v.name, f"p.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
+    if directional:
+        lets += [("real", v.name, f"d.{c}") for v, c in zip(DIRECTION, _COMPONENT, strict=True)]
+    lets += [("real", s.name, printer.doprint(v)) for s, v in program.assignments]
+    outputs = tuple(printer.doprint(o) for o in program.outputs)
+    what = ", ".join(_quantities_of(name))
+    comment = f"{what} at the point p" + (" along the unit direction d" if directional else "")
+    return ShaderFunction(name, comment, params, _RETURN_TYPE[len(outputs)], tuple(lets),
+                          outputs)
+
+
+def _quantities_of(name: str) -> tuple[str, ...]:
+    if name in QUANTITY_ORDER:
+        return (name,)
+    inverse = {v: k for k, v in _LETTER.items()}
+    return tuple(inverse[c] for c in name)
+
+
+def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
+    """The ray record's coefficient fields and ray_of's body: x..z = ro, dx..dz = rd,
+    then the CSE'd coefficient program. (Storing the coefficients of F' and F'' as well
+    measured slower on llvmpipe: a larger ray record, the same loop-invariant products.)"""
+    lets = [("real", v.name, f"ro.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
+    lets += [("real", v.name, f"rd.{c}") for v, c in zip(DIRECTION, _COMPONENT, strict=True)]
+    lets += [("real", s.name, printer.doprint(v)) for s, v in coefficients.assignments]
+    fields = tuple(("real", f"c{k}", f"coefficient of s^{k}")
+                   for k in range(len(coefficients.outputs)))
+    return fields, Code(tuple(lets), tuple(printer.doprint(o) for o in coefficients.outputs))
+
+
+def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
+    """F^(m)(s) = sum_k k!/(k-m)! c_k s^(k-m), each a Horner sum; the products
+    k!/(k-m)! c_k are loop invariant (a compiler hoists them out of the march loop)."""
+    s = _sym("s")
+    c = [_sym(f"ray.c{k}") for k in range(n + 1)]
+    outputs = []
+    for q in quantities:
+        m = RAY_DERIVATIVES.index(q)
+        value: sympy.Expr = sympy.S.Zero
+        for k in range(n, m - 1, -1):
+            value = value * s + sympy.ff(k, m) * c[k]
+        outputs.append(printer.doprint(value))
+    what = ", ".join(quantities)
+    return ShaderFunction(_ray_name(quantities),
+                          f"{what} at ray parameter s: Horner on the ray polynomial",
+                          (("Ray", "ray"), ("real", "s")), _RETURN_TYPE[len(outputs)], (),
+                          tuple(outputs))
