@@ -13,15 +13,15 @@ from functools import lru_cache
 import jinja2
 import sympy
 
-from .backends import get_target
 from .derive import Derivatives, current_max_derived
 from .errors import InputError
 from .methods import Constants, Method, get_method
 from .optimize import Program, optimize
-from .scene import SHADING, View, light_directions
 from .resources import data_dir
+from .scene import SHADING, View, light_directions
 from .surface import Surface
 from .symbols import DIRECTION, POINT
+from .targets import get_target
 
 EMITS = ("program", "library")
 PREFIX_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
@@ -126,7 +126,7 @@ def emit(
         "shading": _print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
-    template = environment().get_template(f"{tgt.name}/{emit}.{tgt.name}.j2")
+    template = environment().get_template(tgt.templates[emit])
     return template.render(context)
 
 

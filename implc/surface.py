@@ -29,8 +29,8 @@ import sympy
 
 from .errors import InputError, Source
 from .parse import Limits, check_param_name, parse_equation, parse_number
-from .scene import View
 from .resources import data_dir
+from .scene import View
 from .textform import to_text
 
 if sys.version_info >= (3, 11):

@@ -26,9 +26,9 @@ import sympy
 from sympy.polys.rings import ring
 
 from ..numeric import evaluate
+from ..scene import View, clip_sphere, pixel_rays, shade
 from ..symbols import DIRECTION, POINT, T, X, Y, Z
 from .result import RenderResult
-from ..scene import View, clip_sphere, pixel_rays, shade
 
 # Ray origin symbols of the coefficient expressions returned by `ray_polynomial`.
 OX, OY, OZ = sympy.symbols("ox oy oz", real=True)
