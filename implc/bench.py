@@ -332,8 +332,8 @@ def _check_args(surfaces, size, methods, frames, backend, equal_step) -> None:
             raise InputError(f"unknown method '{method}'; choose from {', '.join(METHODS)}")
     if len(set(methods)) != len(methods):
         raise InputError("a method is listed twice in --methods")
-    if backend == "reference" or backend not in BACKENDS:
-        choices = ", ".join(b for b in BACKENDS if b != "reference")
+    if backend not in BACKENDS:
+        choices = ", ".join(BACKENDS)
         raise InputError(f"bench needs a GPU backend ({choices}), got '{backend}'")
     if not 0.0 < equal_step < 1e6:
         raise InputError(f"--equal-step must be a positive number (got {equal_step})")

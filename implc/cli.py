@@ -14,11 +14,11 @@ import time
 from pathlib import Path
 
 from . import __version__
-from .backends import TARGETS
 from .errors import EXIT_INTERRUPTED, EXIT_OK, ImplcError, InputError, ValidationError
 from .fileio import write_atomic
 from .methods import METHODS, TAYLOR2_CHOICES, Constants
-from .render.run import BACKENDS
+from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
+from .targets import TARGETS
 
 EPILOG = """\
 surfaces: a TOML file, a bundled example name (see `implc list`), or -e "EQUATION".
@@ -129,9 +129,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("render", help="render a surface to PNG or EXR (+ JSON sidecar)")
     _surface_args(p)
     _shader_args(p)
-    p.add_argument("-b", "--backend", choices=list(BACKENDS), default="gl",
-                   help="gl: GLSL on OpenGL (llvmpipe here); reference: exact CPU float64; "
-                        "see README for the others")
+    p.add_argument("-b", "--backend", choices=[*BACKENDS, REFERENCE], default="gl",
+                   help="; ".join([*(f"{name}: {b.about}" for name, b in BACKENDS.items()),
+                                   f"{REFERENCE}: {REFERENCE_ABOUT}"]) + " (default gl)")
     p.add_argument("--size", type=int, help="square image size in pixels (default 512)")
     p.add_argument("--width", type=int)
     p.add_argument("--height", type=int)
@@ -161,7 +161,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="methods to time (default: taylor curvature hessian-approx hessian sign)")
     p.add_argument("--frames", type=int, default=3,
                    help="timed frames per cell after 1 warm-up; fps is their median (default 3)")
-    p.add_argument("-b", "--backend", choices=[b for b in BACKENDS if b != "reference"],
+    p.add_argument("-b", "--backend", choices=list(BACKENDS),
                    default="gl", help="renderer to time (default gl)")
     p.add_argument("--configs", default="paper,equal,taylor2,extremum",
                    help="comma-separated: paper (Table 1 constants), equal (one step for "
@@ -215,9 +215,13 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
                    help="shader language (default: glsl)")
     p.add_argument("-m", "--method", choices=list(METHODS), default="hessian",
                    help="root-finding method (default: hessian); see README")
-    p.add_argument("--flavor", help="glsl: 330 (default), 450, es300, shadertoy")
-    p.add_argument("--precision", choices=("float", "double"),
-                   help="opencl: float (default) or double (needs an fp64 device)")
+    p.add_argument("--flavor", help="; ".join(
+        f"{t.name}: {', '.join(t.flavors)} (default {t.default_flavor})"
+        for t in TARGETS.values() if len(t.flavors) > 1))
+    precisions = dict.fromkeys(x for t in TARGETS.values() for x in t.precisions)
+    p.add_argument("--precision", choices=list(precisions), help="; ".join(
+        f"{t.name}: {' or '.join(t.precisions)} (default {t.precisions[0]})"
+        for t in TARGETS.values() if len(t.precisions) > 1))
     d = Constants()
     c = p.add_argument_group("method constants (defaults: the paper's Table 1)")
     c.add_argument("--step", type=float, help="base step b (default 0.01; hessian 0.002)")
@@ -347,14 +351,10 @@ def cmd_validate(args) -> int:
 
 
 def cmd_render(args) -> int:
-    from .render.run import render_surface
+    from .render.run import backend_for, render_surface
 
     width, height = _size(args)
-    backend = args.backend
-    if args.precision == "double":  # the double OpenCL program is its own backend
-        if backend not in ("cl", "cl-double"):
-            raise InputError("--precision double renders with -b cl (OpenCL) only")
-        backend = "cl-double"
+    backend = backend_for(args.backend, args.precision)  # a precision is a backend of its own
     surface = _surface(args)
     start = time.perf_counter()
     paths = render_surface(surface, backend, args.method, _constants(args), width, height,

@@ -35,8 +35,9 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from .errors import ImplcError, InputError, ToolError
+from .targets import TARGETS as REGISTRY
 
-TARGETS = ("glsl", "wgsl", "opencl")
+TARGETS: tuple[str, ...] = tuple(REGISTRY)  # every target, in the registry's order
 METHOD = "hessian"
 COLUMNS = ("source", "name", "equation", "params", "degree", "note", "path")
 TSV_NAME = "implicit_surface_corpus.tsv"

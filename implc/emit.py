@@ -14,7 +14,6 @@ from functools import lru_cache
 import jinja2
 import sympy
 
-from .backends import get_target
 from .derive import current_max_derived
 from .errors import InputError
 from .marcher import build_programs, choose_form, function_name, lower, point_sets
@@ -23,6 +22,7 @@ from .optimize import Program
 from .resources import data_dir
 from .scene import SHADING, View, light_directions
 from .surface import Surface
+from .targets import get_target
 
 EMITS = ("program", "library")
 PREFIX_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
@@ -105,7 +105,7 @@ def emit(
         "shading": _print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
-    template = environment().get_template(f"{tgt.name}/{emit}.{tgt.name}.j2")
+    template = environment().get_template(tgt.templates[emit])
     return template.render(context)
 
 

@@ -1,5 +1,8 @@
 """Run the real compiler of each shader language and return its verdict.
 
+Which function validates which language, and which file extensions are which language,
+is the target registry's (implc/targets.py); this module holds the validators.
+
 GLSL: glslangValidator (Khronos reference front end). A shadertoy or library emit has no
 `#version`/`main`, so it is wrapped in templates/glsl/harness.glsl.j2 first and the
 tool's line numbers are mapped back into the user's file.
@@ -15,9 +18,11 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from .devices import FP64, opencl_build, opencl_device, wgpu_device
 from .errors import ToolError
+from .targets import TARGETS, resolve, target_of_file
 
-GLSL_STAGES = {".frag": "frag", ".vert": "vert", ".comp": "comp", ".glsl": "frag"}
+GLSL_STAGES = {".vert": "vert", ".comp": "comp"}  # any other GLSL file is a fragment shader
 
 
 @dataclass(frozen=True)
@@ -95,9 +100,7 @@ def validate_opencl(text: str, name: str = "shader.cl") -> Verdict:
     line numbers are the user's. A double-precision source on a device without
     cl_khr_fp64 fails here, with the reason, rather than with the driver's type errors.
     """
-    from .render.cl_runner import FP64, build, device
-
-    dev = device()
+    dev = opencl_device()
     tool = f"OpenCL build, {dev.name}"
     pragma = re.search(r"^[ \t]*#[ \t]*pragma[ \t]+OPENCL[ \t]+EXTENSION[ \t]+" + FP64, text, re.M)
     if pragma and not dev.has_fp64:
@@ -105,7 +108,7 @@ def validate_opencl(text: str, name: str = "shader.cl") -> Verdict:
         message = (f"{name}:{line}:1: error: double precision needs {FP64}, which this "
                    "device does not support")
         return Verdict(False, tool, message)
-    built = build(text)
+    built = opencl_build(text)
     return Verdict(built.program is not None, tool, _locate_cl(built.log, name))
 
 
@@ -126,9 +129,7 @@ def validate_wgsl(text: str, name: str = "shader.wgsl") -> Verdict:
     the software adapter) and with the `naga` CLI when it is on PATH; both must accept.
     A library emit needs no harness: naga validates a module without entry points.
     Messages are naga's own (`┌─ name:line:col` and a caret), pointing at `name`."""
-    from .render.wgpu_runner import device
-
-    dev = device()  # a missing wgpu or adapter is a ToolError (exit 4)
+    dev = wgpu_device()  # a missing wgpu or adapter is a ToolError (exit 4)
     import wgpu
 
     tools, failures = ["naga (wgpu)"], []
@@ -157,21 +158,17 @@ def validate_wgsl(text: str, name: str = "shader.wgsl") -> Verdict:
     return Verdict(not failures, " + ".join(tools), messages)
 
 
-# target -> validator(text, name); file extension -> target
-VALIDATORS = {"glsl": validate_glsl, "opencl": validate_opencl, "wgsl": validate_wgsl}
-EXTENSIONS = {**{ext: "glsl" for ext in GLSL_STAGES}, ".cl": "opencl", ".wgsl": "wgsl"}
-
-
 def validate_file(path: Path) -> Verdict:
     """Validate a shader file, choosing the language by its extension."""
-    target = EXTENSIONS.get(path.suffix)
+    target = target_of_file(path.suffix)
     if target is None:
-        known = " ".join(sorted(EXTENSIONS))
+        known = " ".join(sorted(ext for t in TARGETS.values() for ext in t.extensions))
         raise ToolError(f"{path}: unknown shader extension '{path.suffix}' (known: {known})")
-    return VALIDATORS[target](path.read_text(encoding="utf-8"), str(path))
+    return validate_text(path.read_text(encoding="utf-8"), target.name, str(path))
 
 
 def validate_text(text: str, target: str, name: str) -> Verdict:
-    if target not in VALIDATORS:
+    """Validate `text` in the language of `target`; `name` is used in the messages."""
+    if target not in TARGETS:
         raise ToolError(f"no validator for target '{target}'")
-    return VALIDATORS[target](text, name)
+    return resolve(TARGETS[target].validator)(text, name)

@@ -2,10 +2,11 @@
 
 OpenCL C is C99 with vector types and its own built-ins, so the C99 printer is the right
 base; the mixin does the shader rules (typed literals, products for integer powers, the
-function table). The precision decides the literal type: `1.0f` in float (an unsuffixed
-literal is a double in OpenCL C and would silently promote the whole expression), plain
-`1.0` in double. The scalar and vector type names (`float3` / `double3`) are chosen in
-templates/opencl/ from the `precision` context variable.
+function table, spelled by `known_functions` below). The precision decides the literal
+type: `1.0f` in float (an unsuffixed literal is a double in OpenCL C and would silently
+promote the whole expression), plain `1.0` in double. The scalar and vector type names
+(`float3` / `double3`) are chosen in templates/opencl/ from the `precision` context
+variable.
 """
 
 from __future__ import annotations
@@ -18,9 +19,19 @@ from .printing import ShaderPrinterMixin
 PRECISIONS = ("float", "double")
 LITERAL_SUFFIX = {"float": "f", "double": ""}
 
+# sympy class name -> OpenCL C built-in, for every row of implc/functions.py that prints as
+# a call (the others: printing.RULES). The float forms of abs/min/max are fabs/fmin/fmax;
+# every built-in here is overloaded for float and double.
+known_functions = {
+    "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
+    "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "exp": "exp",
+    "log": "log", "sqrt": "sqrt", "Abs": "fabs", "sign": "sign", "Min": "fmin", "Max": "fmax",
+}
+
 
 class OpenclPrinter(ShaderPrinterMixin, C99CodePrinter):
     target = "opencl"
+    _kf = known_functions
 
     def __init__(self, precision: str = "float"):
         if precision not in PRECISIONS:

@@ -1,10 +1,12 @@
 """Printing rules shared by every shader target, on top of sympy's CodePrinter family.
 
 A target printer is `class XPrinter(ShaderPrinterMixin, <sympy printer>)` plus a few class
-attributes. The mixin fixes what sympy gets wrong for shaders: typed float literals for
-every number (`2` -> `2.0`), no `pow` for integer powers (the optimizer already turned
-them into products), constants as literals, every function spelled from
-`functions.FUNCTIONS`, and an implc error (not a driver error) for anything unsupported.
+attributes, and its module's `known_functions` (sympy's idiom: sympy class name -> the
+target's function name) as `_kf`. The mixin fixes what sympy gets wrong for shaders: typed
+float literals for every number (`2` -> `2.0`), no `pow` for integer powers (the optimizer
+already turned them into products), constants as literals, exactly the functions of
+`functions.FUNCTIONS` (each spelled by `known_functions` or printed by one of `RULES`),
+and an implc error (not a driver error) for anything unsupported.
 """
 
 from __future__ import annotations
@@ -15,10 +17,25 @@ from sympy.printing.precedence import PRECEDENCE, precedence
 from ..errors import ImplcError
 from ..functions import BY_SYMPY_NAME
 
+# Rows of the function table printed by a rule of the mixin, not spelled by a printer's
+# `known_functions`, and why. Every other row needs a spelling in every printer.
+RULES: dict[str, str] = {
+    "Heaviside": "the derivative of min/max/abs by branch: `print_step`, which a target "
+                 "may override (OpenCL prints a select)",
+    "DiracDelta": "the derivative of sign: 0 almost everywhere, printed as the literal 0",
+}
+
 
 class ShaderPrinterMixin:
     target: str = ""
     float_suffix: str = ""
+    _kf: dict[str, str] = {}  # the printer module's `known_functions`
+
+    def __init__(self, settings: dict) -> None:
+        super().__init__(settings)
+        # sympy's printers fill `known_functions` with their own tables (C99's conditional
+        # fabs/abs, GLSL's extras); implc's table decides what prints, so replace, not merge.
+        self.known_functions = dict(self._kf)
 
     def float_literal(self, value: float) -> str:
         """Shortest decimal that round-trips the float64 value, typed for the target."""
@@ -92,15 +109,15 @@ class ShaderPrinterMixin:
         row = BY_SYMPY_NAME.get(name)
         if row is None:
             raise ImplcError(f"function '{name}' cannot be printed for target {self.target}")
-        if name in ("Min", "Max"):
-            return self._fold(getattr(row, self.target), expr.args)
         if name == "Heaviside":
             return self.print_step(self._print(expr.args[0]))
         if name == "DiracDelta":
             return self.float_literal(0.0)
-        spelled = getattr(row, self.target)
+        spelled = self.known_functions.get(name)
         if not spelled:
             raise ImplcError(f"function '{row.name}' has no {self.target} spelling")
+        if name in ("Min", "Max"):
+            return self._fold(spelled, expr.args)
         return f"{spelled}({', '.join(self._print(a) for a in expr.args)})"
 
     def _fold(self, fname: str, args) -> str:

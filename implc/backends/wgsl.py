@@ -4,8 +4,7 @@ sympy has no WGSL printer, so this one starts from the generic `CodePrinter` (wh
 arithmetic printing is the same as the C family's) and adds only what WGSL needs:
 every literal carries the `f` suffix, so no abstract-float inference is involved;
 `Heaviside` prints as WGSL's `step(0.0f, x)`; names that WGSL reserves are refused in
-implc instead of by naga. Functions are spelled from the `wgsl` column of
-`implc/functions.py` by the shared mixin.
+implc instead of by naga. Functions are spelled by `known_functions` below.
 """
 
 from __future__ import annotations
@@ -46,6 +45,14 @@ RESERVED = frozenset((
 ))
 RESERVED_WORDS = KEYWORDS | RESERVED
 
+# sympy class name -> WGSL built-in, for every row of implc/functions.py that prints as a
+# call (the others: printing.RULES).
+known_functions = {
+    "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
+    "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "exp": "exp",
+    "log": "log", "sqrt": "sqrt", "Abs": "abs", "sign": "sign", "Min": "min", "Max": "max",
+}
+
 
 class WgslPrinter(ShaderPrinterMixin, CodePrinter):
     """Expressions as WGSL f32 code: `2.0f*x*x_2 - sqrt(c0)`."""
@@ -54,6 +61,7 @@ class WgslPrinter(ShaderPrinterMixin, CodePrinter):
     language = "WGSL"
     float_suffix = "f"
     reserved_words = RESERVED_WORDS
+    _kf = known_functions
 
     def __init__(self) -> None:
         super().__init__({"strict": True})

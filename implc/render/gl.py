@@ -11,8 +11,11 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..emit import emit, render_template
 from ..errors import ToolError
+from ..methods import Constants
 from ..scene import View
+from ..surface import Surface
 from .result import RenderResult, TimedRunner
 
 TRIANGLES = 0x0004  # GL_TRIANGLES
@@ -81,3 +84,11 @@ class GlRunner(TimedRunner):
     def release(self) -> None:
         for obj in (self.fbo, self.color, self.aux, self.vao, self.program):
             obj.release()
+
+
+def open_gl_runner(surface: Surface, method: str, constants: Constants, width: int,
+                   height: int) -> GlRunner:
+    """Runner factory of backend `gl`: the 330 core program over a full-screen triangle."""
+    fragment = emit(surface, "glsl", method, constants, flavor="330")
+    vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
+    return GlRunner(fragment, vertex, surface.view, width, height)

@@ -1,35 +1,28 @@
 """Render a surface with a backend and write the outputs: the one entry point for `render`
 and `bench`. A backend is a runner factory: `open_runner(...)` returns an object with
 `frame() -> RenderResult` (render once, wait for completion, read back) and `release()`.
+
+The backends are the targets' (implc/targets.py), plus the exact CPU reference, which
+belongs to no target and runs no method.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
 
-from ..emit import emit, render_template
+from ..errors import InputError
 from ..methods import Constants
 from ..surface import Surface
-from .cl_runner import open_cl_double_runner, open_cl_runner
+from ..targets import TARGETS, Backend, resolve
 from .result import RenderResult
-from .wgpu_runner import open_wgpu_runner
 
 
 class Runner(Protocol):
     def frame(self) -> RenderResult: ...
 
     def release(self) -> None: ...
-
-
-def _gl_runner(surface, method, constants, width, height) -> Runner:
-    from .gl import GlRunner
-
-    fragment = emit(surface, "glsl", method, constants, flavor="330")
-    vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
-    return GlRunner(fragment, vertex, surface.view, width, height)
 
 
 class _ReferenceRunner:
@@ -50,22 +43,37 @@ class _ReferenceRunner:
         pass
 
 
-# backend name -> runner factory(surface, method, constants, width, height)
-BACKENDS: dict[str, Callable[..., Runner]] = {
-    "gl": _gl_runner,
-    "cl": open_cl_runner,  # OpenCL C on PoCL, float; cl-double: the --precision double program
-    "cl-double": open_cl_double_runner,
-    "wgpu": open_wgpu_runner,  # WGSL compute shader on wgpu (Vulkan; lavapipe here)
-    "reference": lambda surface, method, constants, w, h: _ReferenceRunner(surface, w, h),
+REFERENCE = "reference"
+REFERENCE_ABOUT = "the exact CPU reference, float64 (no method)"
+# backend name -> Backend, for every backend of every target (the reference aside)
+BACKENDS: dict[str, Backend] = {
+    name: backend for target in TARGETS.values() for name, backend in target.backends.items()
 }
 
 
 def open_runner(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int
 ) -> Runner:
+    if backend == REFERENCE:
+        return _ReferenceRunner(surface, width, height)
     if backend not in BACKENDS:
-        raise ValueError(f"unknown backend '{backend}'; choose from {', '.join(BACKENDS)}")
-    return BACKENDS[backend](surface, method, constants, width, height)
+        choices = ", ".join([*BACKENDS, REFERENCE])
+        raise ValueError(f"unknown backend '{backend}'; choose from {choices}")
+    return resolve(BACKENDS[backend].runner)(surface, method, constants, width, height)
+
+
+def backend_for(backend: str, precision: str | None) -> str:
+    """The backend of `backend`'s target that runs its program at `precision`
+    (`-b cl --precision double` is `cl-double`); `precision` None keeps `backend`."""
+    if precision is None or (backend == REFERENCE and precision == "float"):
+        return backend
+    for target in TARGETS.values():
+        if backend in target.backends:
+            for name, other in target.backends.items():
+                if other.precision == precision:
+                    return name
+    able = [name for t in TARGETS.values() if precision in t.precisions for name in t.backends]
+    raise InputError(f"--precision {precision} renders with -b {' or '.join(able)} only")
 
 
 def render(
@@ -87,7 +95,7 @@ def metadata(
     surface: Surface, backend: str, method: str, constants: Constants, result: RenderResult
 ) -> dict:
     """The JSON sidecar: enough to recompute every pixel's ray and to reproduce the run."""
-    method_json = {"name": "reference"} if backend == "reference" else {
+    method_json = {"name": REFERENCE} if backend == REFERENCE else {
         "name": method, **constants.as_dict()}
     return {
         "surface": {

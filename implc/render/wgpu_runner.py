@@ -11,11 +11,10 @@ This module is not named `wgpu.py`: that would shadow the wgpu package.
 
 from __future__ import annotations
 
-import os
-from functools import lru_cache
-
 import numpy as np
 
+from ..devices import wgpu_device
+from ..emit import emit
 from ..errors import ToolError
 from ..scene import View
 from .result import RenderResult, TimedRunner
@@ -23,51 +22,6 @@ from .result import RenderResult, TimedRunner
 WORKGROUP = 8  # the workgroup size (8 x 8) in templates/wgsl/program.wgsl.j2
 COLOR_FORMAT = "rgba32float"  # storage-writable in core WebGPU, and exact like GL's f4
 UNIFORM_FLOATS = 20  # struct Uniforms: 80 bytes (README "Drop-in contract (WGSL)")
-
-
-@lru_cache(maxsize=1)
-def device():
-    """One wgpu device per process (creating one costs ~0.5 s on lavapipe).
-
-    Asks for the adapter's largest storage binding so big frames fit the aux buffer.
-    """
-    os.environ.setdefault("XDG_RUNTIME_DIR", "/tmp")
-    try:
-        import wgpu
-    except ImportError as err:  # pragma: no cover - depends on the install
-        raise ToolError("wgpu is not installed (run `make setup`)") from err
-    _vulkan_only()
-    try:
-        adapter = wgpu.gpu.request_adapter_sync(power_preference="low-power")
-    except Exception as err:  # wgpu raises RuntimeError or its own GPUError types
-        raise ToolError(f"no wgpu adapter (install mesa-vulkan-drivers): {err}") from err
-    if adapter is None:
-        raise ToolError("no wgpu adapter (install mesa-vulkan-drivers for lavapipe)")
-    limits = {
-        key: adapter.limits[key]
-        for key in ("max-storage-buffer-binding-size", "max-buffer-size")
-        if key in adapter.limits
-    }
-    try:
-        return adapter.request_device_sync(required_limits=limits)
-    except Exception as err:
-        raise ToolError(f"cannot create a wgpu device: {err}") from err
-
-
-def _vulkan_only() -> None:
-    """Keep wgpu off its GL backend: probing it through EGL makes wgpu's own context
-    current and breaks moderngl's in the same process (GL and wgpu render side by side in
-    tests and `bench`). Only possible before wgpu creates its instance."""
-    try:
-        from wgpu.backends.wgpu_native.extras import set_instance_extras
-
-        set_instance_extras(backends=["Vulkan"])
-    except (ImportError, RuntimeError):  # another wgpu user created the instance first
-        pass
-
-
-def adapter_name() -> str:
-    return str(device().adapter.info.get("device", "unknown"))
 
 
 def _uniforms(view: View, width: int, height: int) -> bytes:
@@ -91,7 +45,7 @@ class WgpuRunner(TimedRunner):
     def __init__(self, program: str, view: View, width: int, height: int):
         import wgpu
 
-        dev = device()
+        dev = wgpu_device()
         self.device, self.width, self.height = dev, width, height
         aux_bytes = width * height * 16
         if aux_bytes > dev.limits["max-storage-buffer-binding-size"]:
@@ -169,8 +123,6 @@ class WgpuRunner(TimedRunner):
 
 
 def open_wgpu_runner(surface, method, constants, width: int, height: int) -> WgpuRunner:
-    """The `wgpu` entry of render.run.BACKENDS: emit the WGSL program and compile it."""
-    from ..emit import emit
-
+    """Runner factory of backend `wgpu`: emit the WGSL program and compile it."""
     program = emit(surface, "wgsl", method, constants)
     return WgpuRunner(program, surface.view, width, height)

@@ -1,0 +1,115 @@
+"""THE target registry: one record per shader language, read by emit, validate, render,
+corpus and the command line's choices and help.
+
+A target is its printer (implc/backends/<name>.py, which also holds its function
+spellings and flavours), its templates (templates/<name>/), the file extensions
+`implc validate` reads as its language, the validator that runs its real compiler, the
+render backends that run its program, and its flavours and precisions. Adding a target
+is one record here plus those files (README "Adding a target").
+
+Layering (README "Architecture"): the registry sits below emit, which reads the printer,
+templates, flavours and precisions from it. The validator and the runners sit above emit
+(they compile and run what emit writes), so a record names them as "module:function"
+strings, imported by `resolve` when they are called: the registry imports only the
+printers below it, and tests/test_targets.py checks that every reference resolves.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+from .backends.glsl import FLAVORS as GLSL_FLAVORS
+from .backends.glsl import GlslPrinter
+from .backends.opencl import PRECISIONS as OPENCL_PRECISIONS
+from .backends.opencl import OpenclPrinter
+from .backends.wgsl import WgslPrinter
+
+
+def resolve(reference: str) -> Callable:
+    """'implc.validate:validate_glsl' -> that function, imported now."""
+    module, _, name = reference.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+@dataclass(frozen=True)
+class Backend:
+    """A render backend: the runner of one target's program at one precision.
+
+    A precision is a backend of its own (`cl`, `cl-double`) so that every runner factory
+    has the same signature: (surface, method, constants, width, height) -> Runner.
+    """
+
+    runner: str  # "module:function", the runner factory
+    about: str  # one line for `implc render --help`
+    precision: str = "float"
+
+
+@dataclass(frozen=True)
+class Target:
+    name: str
+    printer: Callable[..., object]  # printer class: (precision) when several, else ()
+    templates: Mapping[str, str]  # emit form (program, library) -> path under templates/
+    extensions: tuple[str, ...]  # shader files `implc validate` reads as this language
+    validator: str  # "module:function": (text, name) -> validate.Verdict
+    backends: Mapping[str, Backend]  # render backend name -> Backend
+    flavors: Mapping[str, Mapping[str, object]] = field(default_factory=lambda: {"default": {}})
+    default_flavor: str = "default"
+    precisions: tuple[str, ...] = ("float",)
+    vector_types: tuple[str, str, str] = ("float", "vec2", "vec3")  # templates' `types`
+
+
+TARGETS: dict[str, Target] = {target.name: target for target in (
+    Target(
+        name="glsl",
+        printer=GlslPrinter,
+        templates={"program": "glsl/program.glsl.j2", "library": "glsl/library.glsl.j2"},
+        extensions=(".frag", ".glsl", ".vert", ".comp"),
+        validator="implc.validate:validate_glsl",
+        backends={"gl": Backend("implc.render.gl:open_gl_runner",
+                                "GLSL 330 on OpenGL (moderngl, EGL; llvmpipe here)")},
+        flavors=GLSL_FLAVORS,
+        default_flavor="330",
+    ),
+    Target(
+        name="wgsl",
+        printer=WgslPrinter,
+        templates={"program": "wgsl/program.wgsl.j2", "library": "wgsl/library.wgsl.j2"},
+        extensions=(".wgsl",),
+        validator="implc.validate:validate_wgsl",
+        backends={"wgpu": Backend("implc.render.wgpu_runner:open_wgpu_runner",
+                                  "WGSL compute shader on wgpu (Vulkan; lavapipe here)")},
+        vector_types=("f32", "vec2<f32>", "vec3<f32>"),
+    ),
+    Target(
+        name="opencl",
+        printer=OpenclPrinter,
+        templates={"program": "opencl/program.opencl.j2",
+                   "library": "opencl/library.opencl.j2"},
+        extensions=(".cl",),
+        validator="implc.validate:validate_opencl",
+        backends={
+            "cl": Backend("implc.render.cl_runner:open_cl_runner",
+                          "OpenCL C kernel, float (pyopencl; PoCL here)"),
+            "cl-double": Backend("implc.render.cl_runner:open_cl_double_runner",
+                                 "the same in double precision (needs cl_khr_fp64)",
+                                 precision="double"),
+        },
+        # templates/opencl/ spell double/double2/double3 from `precision`
+        precisions=OPENCL_PRECISIONS,
+        vector_types=("float", "float2", "float3"),
+    ),
+)}
+
+
+def get_target(name: str) -> Target:
+    try:
+        return TARGETS[name]
+    except KeyError:
+        raise ValueError(f"unknown target '{name}'; choose from {', '.join(TARGETS)}") from None
+
+
+def target_of_file(suffix: str) -> Target | None:
+    """The target whose language a shader file with this extension is written in."""
+    return next((t for t in TARGETS.values() if suffix in t.extensions), None)

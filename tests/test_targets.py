@@ -1,0 +1,131 @@
+"""The target registry (implc/targets.py) against what it names: extensions, templates,
+validators, runners, precisions, and every function of the table spelled by every
+printer and accepted by every real compiler."""
+
+from __future__ import annotations
+
+import inspect
+
+import pytest
+import sympy
+from conftest import IN_CI
+
+from implc.backends.printing import RULES
+from implc.emit import EMITS, emit
+from implc.errors import ToolError
+from implc.functions import BY_SYMPY_NAME, FUNCTIONS
+from implc.render.run import BACKENDS, REFERENCE, backend_for
+from implc.resources import data_dir
+from implc.surface import Surface
+from implc.symbols import X, Y, Z
+from implc.targets import TARGETS, resolve, target_of_file
+from implc.validate import validate_text
+
+NAMES = list(TARGETS)
+
+
+def printers(target):
+    """One printer per precision of `target`, as emit makes them."""
+    if len(target.precisions) == 1:
+        return [target.printer()]
+    return [target.printer(precision) for precision in target.precisions]
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_extension_maps_back_to_its_target(name):
+    target = TARGETS[name]
+    assert target.extensions, f"{name} has no file extension"
+    for extension in target.extensions:
+        assert extension.startswith(".")
+        assert target_of_file(extension) is target, f"{extension} is read as another target"
+    others = {e for t in TARGETS.values() if t is not target for e in t.extensions}
+    assert not others & set(target.extensions), f"{name} shares an extension"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_templates_cover_every_emit_form(name):
+    target = TARGETS[name]
+    assert set(target.templates) == set(EMITS)
+    for path in target.templates.values():
+        assert (data_dir("templates") / path).is_file(), path
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_validator_and_runners_resolve_with_their_signatures(name):
+    """The lazy "module:function" references: each imports and takes the agreed arguments."""
+    target = TARGETS[name]
+    inspect.signature(resolve(target.validator)).bind("text", "name")
+    assert target.backends, f"{name} has no render backend"
+    for backend in target.backends.values():
+        inspect.signature(resolve(backend.runner)).bind(
+            "surface", "method", "constants", "width", "height")
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_precision_has_one_backend_and_flavours_have_a_default(name):
+    target = TARGETS[name]
+    precisions = [b.precision for b in target.backends.values()]
+    assert sorted(precisions) == sorted(target.precisions), name
+    for backend_name in target.backends:
+        for precision in target.precisions:
+            chosen = backend_for(backend_name, precision)
+            assert target.backends[chosen].precision == precision
+    assert target.default_flavor in target.flavors
+
+
+def test_backend_names_are_unique_and_not_the_reference():
+    names = [n for t in TARGETS.values() for n in t.backends]
+    assert len(names) == len(set(names)) == len(BACKENDS)
+    assert REFERENCE not in names
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_table_function_has_a_spelling_or_a_rule(name):
+    """Each row printed as a call is in the printer's `known_functions`; the rest are
+    printing.RULES (with their reason) or sugar built from other rows. Nothing else."""
+    for printer in printers(TARGETS[name]):
+        spelled = printer.known_functions
+        for row in FUNCTIONS:
+            if row.sympy_name is None:  # sugar: what it builds must be rows of the table
+                built = row.build(*[X, Y][: row.arity])
+                classes = {type(f).__name__ for f in built.atoms(sympy.Function)}
+                assert classes <= set(BY_SYMPY_NAME), f"{row.name} builds {classes}"
+            elif row.sympy_name in RULES:
+                assert row.sympy_name not in spelled, f"{row.name}: a rule and a spelling"
+            else:
+                assert spelled.get(row.sympy_name), f"{name} has no spelling of {row.name}"
+        dead = set(spelled) - (set(BY_SYMPY_NAME) - set(RULES))
+        assert not dead, f"{name} spells {dead}, which are not table functions"
+
+
+def every_function_surface() -> Surface:
+    """Every user function of the table; its derivatives add the rows only derivatives
+    use (step, delta)."""
+    args = (X / 2 + sympy.Rational(1, 4), Y / 3 - sympy.Rational(1, 5))
+    expr = sum((f.build(*args[: f.arity]) for f in FUNCTIONS if f.user), sympy.Integer(0))
+    return Surface("every function", expr + Z)
+
+
+def validated(text: str, target: str, name: str):
+    try:
+        return validate_text(text, target, name)
+    except ToolError as err:
+        if IN_CI:
+            pytest.fail(f"the {target} compiler is required under CI=true: {err}")
+        pytest.skip(f"no {target} compiler: {err}")
+
+
+@pytest.mark.parametrize("form", EMITS)
+@pytest.mark.parametrize("name", NAMES)
+def test_every_table_function_prints_and_validates(name, form):
+    """What the printers spell, the real compiler of each language accepts, in every
+    precision and emit form."""
+    target = TARGETS[name]
+    surface = every_function_surface()
+    for precision, printer in zip(target.precisions, printers(target), strict=True):
+        text = emit(surface, name, "hessian", emit=form, precision=precision)
+        for spelling in set(printer.known_functions.values()):
+            assert f"{spelling}(" in text, f"{spelling} is not used: the test lost a function"
+        file = f"functions.{precision}.{form}{target.extensions[0]}"
+        verdict = validated(text, name, file)
+        assert verdict.ok, verdict.render(file)
