@@ -10,7 +10,7 @@ OUT := out
 APT_PACKAGES := glslang-tools libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
   pocl-opencl-icd
 
-.PHONY: setup demo test golden lint bench clean system-packages fuzz corpus
+.PHONY: setup demo test golden lint bench bench-baseline forms clean system-packages fuzz corpus
 
 setup: system-packages $(STAMP)
 
@@ -32,9 +32,9 @@ $(STAMP): pyproject.toml
 
 demo: setup
 	@mkdir -p $(OUT)
-	$(PY) -m implc compile cross-cap -t glsl -m hessian --validate -o $(OUT)/cross-cap-hessian.frag
-	$(PY) -m implc render cross-cap -m hessian --size 512 -o $(OUT)/cross-cap-hessian.png
-	@echo "demo: look at $(CURDIR)/$(OUT)/cross-cap-hessian.png (shader: $(OUT)/cross-cap-hessian.frag)"
+	$(PY) -m implc compile cross-cap -t glsl -m exact --validate -o $(OUT)/cross-cap-exact.frag
+	$(PY) -m implc render cross-cap -m exact --size 512 -o $(OUT)/cross-cap-exact.png
+	@echo "demo: look at $(CURDIR)/$(OUT)/cross-cap-exact.png (shader: $(OUT)/cross-cap-exact.frag)"
 
 test: setup
 	$(PY) -m ruff check implc tests
@@ -55,6 +55,22 @@ lint: setup
 BENCH_SIZE := 1024
 bench: setup
 	$(PY) -m implc bench cross-cap miter steiner --size $(BENCH_SIZE) --frames 3 -o results/
+
+# Generated against the hand-written GLSL of templates/baseline/ (Cross-Cap, taylor and
+# hessian), frames taken in turns: paper = taylor b 0.01 and hessian b 0.002, equal = both
+# at b 0.01; at 512^2 and 1024^2 (issue 10's bar: generated >= 0.95x hand-written).
+bench-baseline: setup
+	for size in 512 1024; do \
+	  $(PY) -m implc bench cross-cap --baseline --methods taylor hessian exact \
+	    --configs paper,equal --equal-step 0.01 --size $$size --frames 5 \
+	    -o results/baseline-$$size/ || exit 1; \
+	done
+
+# Point versus ray-poly evaluation (accuracy, speed) and the cost-growth plot (degree 2-12).
+forms: setup
+	$(PY) scripts/eval_forms.py accuracy --size 512 cross-cap miter steiner roman torus tooth \
+	  sphere kummer cayley clebsch ding-dong whitney-umbrella barth-sextic heart
+	$(PY) scripts/eval_forms.py sweep --size 256 --methods taylor --plot docs/cost-growth.png
 
 # Fuzzing (tests/test_fuzz.py) at FUZZ_SCALE times the short pass that `make test` runs
 # (FUZZ_PATH_SCALE for the slower whole-path tests), a fresh seed each run: 100,000+

@@ -46,8 +46,10 @@ from .render.result import RenderResult
 from .render.run import BACKENDS, metadata, open_runner
 from .surface import Surface
 
-# Table 1's columns in the paper's order, then `sign` (not in the paper; informative).
-DEFAULT_METHODS: tuple[str, ...] = ("taylor", "curvature", "hessian-approx", "hessian", "sign")
+# Table 1's columns in the paper's order, then `sign` (not in the paper; informative) and
+# `exact` (implc's root isolation, beyond the paper).
+DEFAULT_METHODS: tuple[str, ...] = ("taylor", "curvature", "hessian-approx", "hessian", "sign",
+                                    "exact")
 CONFIG_NAMES: tuple[str, ...] = ("paper", "equal", "taylor2", "extremum")
 EQUAL_STEP = 0.002  # the paper's hessian step, given to every method in `equal`
 TILE = 256  # figure tile size in pixels
@@ -89,11 +91,11 @@ def make_configs(names: Sequence[str], equal_step: float = EQUAL_STEP) -> list[B
         "taylor2": BenchConfig(
             "taylor2", "Eq. 4 consistent (h^2/8, F''(t1) in r) at the paper's constants; "
             "taylor is unaffected and re-timed as the fps baseline",
-            {"taylor2": "consistent"}, methods=("taylor", "hessian-approx", "hessian")),
+            {"taylor2": "consistent"}, methods=("taylor", "hessian-approx", "hessian", "exact")),
         "extremum": BenchConfig(
             "extremum", "implc's extremum test (consistent Eq. 4 plus the extremum of each "
             "end's quadratic model) at the paper's constants; taylor re-timed as the baseline",
-            {"taylor2": "extremum"}, methods=("taylor", "hessian-approx", "hessian")),
+            {"taylor2": "extremum"}, methods=("taylor", "hessian-approx", "hessian", "exact")),
     }
     configs = []
     for name in names:
@@ -139,6 +141,8 @@ class BenchRun:
     machine: dict
     reference_seconds: dict[str, float] = field(default_factory=dict)
     cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)  # (config, surf, m)
+    # the hand-written programs (implc/baseline.py), timed in turns with the generated ones
+    baseline_cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)
     tiles: dict[tuple[str, str, str], object] = field(default_factory=dict)  # PIL thumbnails
 
     def config_methods(self, config: BenchConfig) -> list[str]:
@@ -175,6 +179,9 @@ class BenchRun:
                 }
                 for c in self.configs
             ],
+            "baseline": [{"config": c, "surface": k, "method": m, **cell.as_json(),
+                          "generated_fps": self.cells[c, k, m].fps}
+                         for (c, k, m), cell in self.baseline_cells.items()],
             "paper_table1": {k: {m: {"fps": v[0], "ssim": v[1]} for m, v in row.items()}
                              for k, row in PAPER_TABLE1.items()},
         }
@@ -245,12 +252,16 @@ def run_bench(
     configs: Sequence[str] = CONFIG_NAMES,
     equal_step: float = EQUAL_STEP,
     exr: bool = False,
+    baseline: bool = False,
     progress: TextIO | None = sys.stderr,
 ) -> BenchRun:
     """Measure every configuration x surface x method and write the outputs to `out_dir`.
 
     `surfaces` maps a short key (file stem, e.g. "cross-cap") to the loaded surface.
+    With `baseline`, the hand-written programs of implc/baseline.py (GL only) are timed
+    in the same rounds as the generated ones.
     """
+    from .baseline import has_baseline, open_baseline_runner
     from .figure import tile_image
     from .render.image_io import write_render
 
@@ -284,6 +295,7 @@ def run_bench(
         chosen = config.applies_to(methods)
         for key, surface in surfaces.items():
             constants = [METHODS[m].constants(**config.overrides) for m in chosen]
+            hand = [m for m in chosen if baseline and backend == "gl" and has_baseline(key, m)]
             runners, setup = [], []
             try:
                 for method, method_constants in zip(chosen, constants, strict=True):
@@ -291,6 +303,9 @@ def run_bench(
                     runners.append(
                         open_runner(surface, backend, method, method_constants, size, size))
                     setup.append(time.perf_counter() - start)
+                for method in hand:
+                    runners.append(open_baseline_runner(
+                        key, method, constants[chosen.index(method)], surface, size, size))
                 seconds, results = time_interleaved(runners, frames)
             finally:
                 for runner in runners:
@@ -310,6 +325,12 @@ def run_bench(
                 run.tiles[config.name, key, method] = tile_image(result.color, TILE)
                 say(f"[{done:>{len(str(total))}}/{total}] {key} {method} {config.name}: "
                     f"{fps:.3g} fps")
+            for offset, method in enumerate(hand):
+                index = len(chosen) + offset
+                fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
+                run.baseline_cells[config.name, key, method] = Cell(
+                    fps, seconds[index], 0.0, compare(results[index], references[key]), "")
+                say(f"    {key} {method} {config.name}, hand-written baseline: {fps:.3g} fps")
             del results
     run.machine["load_average_end"] = _load_average()
     _fill_ratios(run)
@@ -435,8 +456,37 @@ def format_markdown(run: BenchRun) -> str:
             cells = [_cell_text(run.cells.get((config.name, key, m))) for m in methods]
             lines.append(f"| {key} | " + " | ".join(cells) + " |")
         lines.append("")
+    lines += _baseline_table(run)
     lines += _paper_comparison(run)
     return "\n".join(lines)
+
+
+def _baseline_table(run: BenchRun) -> list[str]:
+    """Generated against hand-written (implc/baseline.py), frames taken in turns."""
+    if not run.baseline_cells:
+        return []
+    lines = [
+        "## generated against hand-written",
+        "",
+        "The hand-written GLSL of templates/baseline/ does the same work as the generated "
+        "program (same step rule, test, refinement after the loop, camera, shading and "
+        "outputs); its frames were taken in the same rounds. Ratio: generated fps / "
+        "hand-written fps (1.00 = as fast).",
+        "",
+        "| config | surface | method | step | generated fps | hand-written fps | ratio | "
+        "hand-written false / missed / wrong |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for (config, key, method), hand in run.baseline_cells.items():
+        generated = run.cells[config, key, method]
+        step = METHODS[method].constants(
+            **next(c for c in run.configs if c.name == config).overrides).step
+        m = hand.metrics
+        lines.append(f"| {config} | {key} | {method} | {step:g} | {generated.fps:.3g} | "
+                     f"{hand.fps:.3g} | {generated.fps / hand.fps:.2f} | "
+                     f"{m['false_hits']} / {m['missed_hits']} / {m['wrong_root']} |")
+    lines.append("")
+    return lines
 
 
 def _paper_comparison(run: BenchRun) -> list[str]:

@@ -16,6 +16,7 @@ from pathlib import Path
 from . import __version__
 from .errors import EXIT_INTERRUPTED, EXIT_OK, ImplcError, InputError, ValidationError
 from .fileio import write_atomic
+from .marcher import AUTO_MAX_DEGREE, EVAL_CHOICES, EXACT_MAX_DEGREE
 from .methods import METHODS, TAYLOR2_CHOICES, Constants
 from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
 from .targets import TARGETS
@@ -104,8 +105,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("show", help="print the equation, degree, derivatives and op counts")
     _surface_args(p)
-    p.add_argument("-m", "--method", choices=sorted(METHODS), default="hessian",
-                   help="method whose shader functions to count (default: hessian)")
+    p.add_argument("-m", "--method", choices=sorted(METHODS), default=None,
+                   help="method whose shader functions to count (default: exact for "
+                        "polynomials, else hessian)")
     p.set_defaults(run=cmd_show)
 
     p = sub.add_parser("compile", help="emit a shader for a surface",
@@ -171,6 +173,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="base step of every method in the `equal` configuration (default 0.002)")
     p.add_argument("--exr", action="store_true",
                    help="also write each render as EXR (for `implc compare`; 24 MB at 1024²)")
+    p.add_argument("--baseline", action="store_true",
+                   help="also time the hand-written GLSL of templates/baseline/ (Cross-Cap, "
+                        "taylor and hessian; gl) in turns with the generated programs and "
+                        "report generated / hand-written speed")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="output directory (created if missing)")
     p.set_defaults(run=cmd_bench)
@@ -213,8 +219,9 @@ def _limit_args(p: argparse.ArgumentParser) -> None:
 def _shader_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-t", "--target", choices=list(TARGETS), default="glsl",
                    help="shader language (default: glsl)")
-    p.add_argument("-m", "--method", choices=list(METHODS), default="hessian",
-                   help="root-finding method (default: hessian); see README")
+    p.add_argument("-m", "--method", choices=list(METHODS), default=None,
+                   help="root-finding method (default: exact for polynomial surfaces up to "
+                        f"degree {EXACT_MAX_DEGREE}, else hessian); see README \"The methods\"")
     p.add_argument("--flavor", help="; ".join(
         f"{t.name}: {', '.join(t.flavors)} (default {t.default_flavor})"
         for t in TARGETS.values() if len(t.flavors) > 1))
@@ -233,6 +240,11 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
     c.add_argument("--taylor2", choices=TAYLOR2_CHOICES,
                    help="Eq. 4 as printed (paper, default) or consistent (h^2/8, F''(t1))")
     c.add_argument("--max-steps", type=int, help=f"march step cap per ray (default {d.max_steps})")
+    p.add_argument("--eval", choices=EVAL_CHOICES, help=(
+        "how F, F', F'' are computed along a ray: point (3-D functions of p = o + s d), "
+        "ray-poly (polynomial S: the ray polynomial's coefficients once per ray, then Horner), "
+        "auto (default: ray-poly for polynomials up to degree "
+        f"{AUTO_MAX_DEGREE}, else point); see README \"Evaluation forms\""))
 
 
 # Every field of implc.parse.Limits, as the option its error messages name.
@@ -285,6 +297,7 @@ def _constants(args) -> Constants:
     values = {
         "step": args.step, "tau1": args.tau1, "tau2": args.tau2, "tau3": args.tau3,
         "eps": args.eps, "taylor2": args.taylor2, "max_steps": args.max_steps,
+        "evaluation": args.eval,
     }
     for key in ("step", "tau1", "tau2", "tau3", "eps"):
         value = values[key]
@@ -307,10 +320,20 @@ def cmd_list(args) -> int:
     return EXIT_OK
 
 
+def _resolve_method(args, surface) -> None:
+    """-m's default depends on the surface: exact where it applies, else hessian."""
+    from .marcher import default_method
+
+    if args.method is None:
+        args.method = default_method(surface.expr)
+
+
 def cmd_show(args) -> int:
     from .show import describe
 
-    print(describe(_surface(args), METHODS[args.method]))
+    surface = _surface(args)
+    _resolve_method(args, surface)
+    print(describe(surface, METHODS[args.method]))
     return EXIT_OK
 
 
@@ -318,6 +341,7 @@ def cmd_compile(args) -> int:
     from .emit import emit
 
     surface = _surface(args)
+    _resolve_method(args, surface)
     text = emit(surface, args.target, args.method, _constants(args), args.flavor, args.emit,
                 args.prefix, precision=args.precision)
     if args.validate:
@@ -356,6 +380,7 @@ def cmd_render(args) -> int:
     width, height = _size(args)
     backend = backend_for(args.backend, args.precision)  # a precision is a backend of its own
     surface = _surface(args)
+    _resolve_method(args, surface)
     start = time.perf_counter()
     paths = render_surface(surface, backend, args.method, _constants(args), width, height,
                            args.output)
@@ -397,6 +422,7 @@ def cmd_bench(args) -> int:
         surfaces, args.output, size=args.size, methods=args.methods or DEFAULT_METHODS,
         frames=args.frames, backend=args.backend, configs=configs,
         equal_step=EQUAL_STEP if args.equal_step is None else args.equal_step, exr=args.exr,
+        baseline=args.baseline,
     )
     return EXIT_OK
 

@@ -212,11 +212,64 @@ RAY_PARAMETER = sympy.Symbol("s", real=True)
 
 
 def ray_coefficients(expr: sympy.Expr) -> tuple[sympy.Expr, ...] | None:
-    """c_0 .. c_n of the ray polynomial F(s) = S(o + s d) = sum c_k s^k, as polynomials in
+    """c_0 .. c_n of the ray polynomial F(s) = S(o + s d) = sum c_k s^k, as expressions in
     the origin o = (x, y, z) and the direction d = (dx, dy, dz); None when S is not a
-    polynomial. (The `ray-poly` evaluation form computes them once per ray.)"""
-    if polynomial_degree(expr) is None:
+    polynomial. (The `ray-poly` evaluation form computes them once per ray.)
+
+    Computed by truncated polynomial arithmetic in s over S's own expression tree, never
+    by expanding: x becomes x + dx s, a product multiplies coefficient lists, a power
+    squares them. The work then follows the shape of the equation as written (the
+    Cross-Cap's 4x^2(x^2 + y^2 + z^2 + z) + y^2(y^2 + z^2 - 1) is two products of
+    quadratics in s), as an expert writes it by hand, and expansion never runs (it takes
+    minutes on the corpus's degree-12 rows)."""
+    degree = polynomial_degree(expr)
+    if degree is None:
         return None
-    s = RAY_PARAMETER
-    moved = expr.xreplace({v: v + s * d for v, d in zip(POINT, DIRECTION, strict=True)})
-    return tuple(sympy.Poly(moved, s).all_coeffs()[::-1])
+    memo: dict[sympy.Basic, list[sympy.Expr]] = {}
+    coefficients = _ray_poly(expr, degree, memo)
+    coefficients += [sympy.S.Zero] * (degree + 1 - len(coefficients))
+    return tuple(coefficients[: degree + 1])
+
+
+def _ray_poly(node: sympy.Basic, n: int, memo: dict) -> list[sympy.Expr]:
+    """The coefficients (lowest first) of `node` along the ray, truncated at degree n."""
+    if node in memo:
+        return memo[node]
+    if node in POINT:
+        result = [node, DIRECTION[POINT.index(node)]]
+    elif not node.free_symbols & set(POINT):
+        result = [node]
+    elif node.is_Add:
+        result = []
+        for arg in node.args:
+            result = _poly_add(result, _ray_poly(arg, n, memo))
+    elif node.is_Mul:
+        result = [sympy.S.One]
+        for arg in node.args:
+            result = _poly_mul(result, _ray_poly(arg, n, memo), n)
+    elif node.is_Pow and node.exp.is_Integer and int(node.exp) >= 0:
+        result = [sympy.S.One]
+        square = _ray_poly(node.base, n, memo)
+        e = int(node.exp)
+        while e:
+            if e & 1:
+                result = _poly_mul(result, square, n)
+            e >>= 1
+            if e:
+                square = _poly_mul(square, square, n)
+    else:  # pragma: no cover - polynomial_degree() said S is a polynomial
+        raise ValueError(f"not a polynomial node: {node}")
+    memo[node] = result
+    return result
+
+
+def _poly_add(a: list, b: list) -> list:
+    size = max(len(a), len(b))
+    return [(a[k] if k < len(a) else 0) + (b[k] if k < len(b) else 0) for k in range(size)]
+
+
+def _poly_mul(a: list, b: list, n: int) -> list:
+    size = min(len(a) + len(b) - 1, n + 1)
+    return [sympy.Add(*(a[i] * b[k - i] for i in range(max(0, k - len(b) + 1),
+                                                        min(k, len(a) - 1) + 1)))
+            for k in range(size)]

@@ -66,7 +66,7 @@ def emit(
     emit: str = "program",
     prefix: str = "",
     precision: str | None = None,
-    evaluation: str = "auto",
+    evaluation: str | None = None,
 ) -> str:
     """The complete shader text for `surface` (deterministic, byte for byte)."""
     tgt = get_target(target)
@@ -84,11 +84,11 @@ def emit(
     if precision not in tgt.precisions:
         raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
     printer = tgt.printer(precision) if len(tgt.precisions) > 1 else tgt.printer()
-    form = choose_form(surface.expr, evaluation)
+    form = choose_form(surface.expr, evaluation or constants.evaluation)
     marcher = lower(meth, constants, surface.expr, form, printer, prefix,
                     current_max_derived())
     label = meth.name + (f" (Eq. 4: {constants.taylor2})" if meth.reads_taylor2 else "")
-    literals = {"zero": 0.0, "half": 0.5, "one": 1.0}
+    literals = {"zero": 0.0, "half": 0.5, "one": 1.0, "four": 4.0}
     context = {
         "surface": {"name": surface.name, "equation": surface.equation},
         "method": meth.name,
@@ -102,7 +102,7 @@ def emit(
         "flavor": tgt.flavors[flavor],
         "flavor_name": flavor,
         "precision": precision,
-        "shading": _print_shading(surface.view, printer),
+        "shading": print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
     template = environment().get_template(tgt.templates[emit])
@@ -121,7 +121,7 @@ def _types(vector_types: tuple[str, str, str], precision: str, prefix: str) -> d
             "bool": "bool", "Ray": prefix + "Ray", "Hit": prefix + "Hit"}
 
 
-def _print_shading(view: View, printer) -> dict:
+def print_shading(view: View, printer) -> dict:
     f = printer.float_literal
 
     def vec(v) -> list[str]:

@@ -13,10 +13,11 @@ Evaluation forms (DESIGN.md section 2) say how a ray quantity at a ray parameter
 computed; a method never knows which one it gets:
 - `point`: jointly CSE'd functions of p = ray.o + s*ray.d and d: `SDH(p, d)` returns
   (F, F', F'') together;
-- `ray-poly` (polynomial S): the coefficients c_k of F(s) = S(o + s d) are computed once
-  per ray in `ray_of` and kept in the ray record; F, F', F'' at s are Horner sums over them
-  (`ray_SDH(ray, s)`), about n multiply-adds each for degree n. Quantities that are not
-  ray derivatives (the Laplacian) stay point functions.
+- `ray-poly` (polynomial S): the coefficients c_k of F(s) = S(o + s d), expanded about
+  the middle of the march interval, are computed once per ray in `ray_of` and kept in
+  the ray record; F' and F'' at s are Horner sums over them (`ray_DH(ray, s)`), about n
+  multiply-adds each for degree n. F itself (see RAY_DERIVATIVES) and quantities that
+  are not ray derivatives (the Laplacian) stay point functions.
 """
 
 from __future__ import annotations
@@ -54,7 +55,20 @@ EVAL_CHOICES = ("auto", *FORMS)
 AUTO_MAX_DEGREE = 12
 
 QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
-RAY_DERIVATIVES = ("S", "dS", "d2S")  # what Horner on the ray polynomial gives
+# What Horner on the ray polynomial gives: F' and F''. F itself, whose sign is the
+# answer, is Horner's only where that sign is certain: Horner's float32 value of F, from
+# coefficients rounded once per ray, errs by a smooth offset along the whole ray, which
+# near a double line of a self-intersecting surface adds or removes a pair of roots
+# (measured on the Cross-Cap, Miter and Roman surfaces with hessian at 512^2: 2-6
+# false-hit pixels each where point evaluation has none). The marchers take F at the
+# point (measured: the same false / missed / wrong-root counts as point evaluation on
+# every bundled polynomial, docs/RESULTS.md); the exact solver's `ray_F` returns Horner's
+# h where |h| exceeds the bound of its rounding error (HORNER_ERR times the size of F's
+# terms on the interval, in the ray record) and S at the point otherwise, which measured
+# faster there (a march step decides a sign near the surface far more often than the
+# solver, whose evaluations are mostly far from it) and as accurate.
+RAY_DERIVATIVES = ("dS", "d2S")
+_DERIVATIVE_ORDER = {"S": 0, "dS": 1, "d2S": 2}
 _LETTER = {"S": "S", "dS": "D", "d2S": "H", "lap": "L"}
 _RETURN_TYPE = {1: "real", 2: "vec2", 3: "vec3"}
 _COMPONENT = ("x", "y", "z")
@@ -68,6 +82,35 @@ def function_name(quantities: Sequence[str]) -> str:
     return "".join(_LETTER[q] for q in quantities)
 
 
+# The exact method's highest degree: its solver is unrolled per derivative level (code
+# grows like n^2) and float32 Horner on degree-n coefficients loses about n bits;
+# measured correct up to 12 (docs/RESULTS.md, "The exact method").
+EXACT_MAX_DEGREE = 12
+
+
+def check_exact(expr: sympy.Expr) -> int:
+    """The degree of S, or an InputError saying why `-m exact` does not apply."""
+    from .methods import METHODS
+
+    marching = ", ".join(m for m, meth in METHODS.items() if not meth.solves)
+    degree = polynomial_degree(expr)
+    if degree is None:
+        raise InputError("-m exact needs a polynomial surface (it isolates the roots of the "
+                         f"ray polynomial); this one is not: use one of {marching}")
+    if degree > EXACT_MAX_DEGREE:
+        raise InputError(f"-m exact supports degree up to {EXACT_MAX_DEGREE} (float32 root "
+                         f"isolation is measured correct up to there); this surface has "
+                         f"degree {degree}: use one of {marching}")
+    return degree
+
+
+def default_method(expr: sympy.Expr) -> str:
+    """The method `-m` defaults to: `exact` where it applies (polynomials up to
+    EXACT_MAX_DEGREE; measured the most accurate and the fastest), else `hessian`."""
+    degree = polynomial_degree(expr)
+    return "exact" if degree is not None and degree <= EXACT_MAX_DEGREE else "hessian"
+
+
 def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
     """The evaluation form for `expr`: `point` or `ray-poly` (see AUTO_MAX_DEGREE)."""
     if requested not in EVAL_CHOICES:
@@ -79,7 +122,7 @@ def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
                          "(use --eval point or auto)")
     if requested != "auto":
         return requested
-    return "point"  # until the accuracy of ray-poly is measured (issue 10)
+    return "ray-poly" if degree is not None and degree <= AUTO_MAX_DEGREE else "point"
 
 
 @dataclass(frozen=True)
@@ -103,6 +146,15 @@ class Code:
 
 
 @dataclass(frozen=True)
+class Solver:
+    """What templates/solver.j2 needs for the `exact` method on a degree-n polynomial."""
+
+    degree: int
+    bottom: int  # the level solved in closed form: 2 (a quadratic) or 1 (linear)
+    closed: tuple[str, ...]  # that level's coefficients a_0.. (printed), lowest first
+
+
+@dataclass(frozen=True)
 class Marcher:
     """Everything method- and form-specific the skeleton prints."""
 
@@ -115,6 +167,7 @@ class Marcher:
     fd: Code
     step: Code
     root: Code
+    solver: Solver | None = None
 
 
 # --- what a method evaluates where ---------------------------------------------------
@@ -137,7 +190,8 @@ def _sample_groups(method: Method) -> dict[sympy.Expr, tuple[str, ...]]:
 
 
 def _split(quantities: tuple[str, ...], form: str) -> list[tuple[str, tuple[str, ...]]]:
-    """A quantity set as (kind, subset) calls: kind `ray` (Horner) or `point`."""
+    """A quantity set as (kind, subset) calls: `ray` (Horner: F', F'') or `point` (F and
+    the rest; see RAY_DERIVATIVES)."""
     if form == "point":
         return [("point", quantities)]
     ray = tuple(q for q in quantities if q in RAY_DERIVATIVES)
@@ -197,6 +251,9 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
           prefix: str, max_derived: int) -> Marcher:
     """Print the method's pieces in `form` with `printer`; global names start with
     `prefix`."""
+    if method.solves:
+        check_exact(expr)
+        return _lower_solver(constants, expr, printer, prefix, max_derived)
     const_names = {c: sympy.Symbol(prefix.upper() + c.name, real=True)
                    for c in CONSTANT_SYMBOLS}
 
@@ -237,8 +294,9 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     for arg, group in _sample_groups(method).items():
         calls(group, arg, "e", lets, replace)
     sample = Code(tuple(lets), tuple(show(e.xreplace(replace)) for e in method.sample))
-    kind, _ = _split(REFINE_SET, form)[0]
-    fd = Code((), (call(kind, REFINE_SET, S),))
+    lets, replace = [], {}
+    calls(REFINE_SET, S, "e", lets, replace)
+    fd = Code(tuple(lets), tuple(show(_apply(q, S).xreplace(replace)) for q in REFINE_SET))
 
     # step rule: a ray quantity in it is evaluated inline, on the branch that reads it
     ends0 = {F0: _sym("f0.x"), D0: _sym("f0.y"), X0: _sym("f0.z")}
@@ -262,6 +320,11 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),
                 ("int", prefix.upper() + "REFINE_STEPS", str(int(constants.refine_steps))))
     return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root)
+
+
+def _abs(printer) -> str:
+    """The float absolute value's name (OpenCL's abs is for integers)."""
+    return printer.doprint(sympy.Abs(_sym("h"))).split("(")[0]
 
 
 def _sym(name: str) -> sympy.Symbol:
@@ -299,25 +362,61 @@ def _quantities_of(name: str) -> tuple[str, ...]:
 
 
 def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
-    """The ray record's coefficient fields and ray_of's body: x..z = ro, dx..dz = rd,
-    then the CSE'd coefficient program. (Storing the coefficients of F' and F'' as well
-    measured slower on llvmpipe: a larger ray record, the same loop-invariant products.)"""
-    lets = [("real", v.name, f"ro.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
+    """The ray record's fields and ray_of's body. The polynomial is expanded about the
+    middle of the march interval, sm (F(s) = sum c_k (s - sm)^k, so |s - sm| is at most
+    hr, half the chord): about the entry point its terms would be up to 3^n times larger
+    for the same sum, and float32 Horner loses that much more to cancellation. `size`,
+    sum |c_k| hr^k, bounds the terms of F on the interval: the unit of Horner's rounding
+    error (ray_F) and of the exact method's touch tolerance. Storing the coefficients of
+    F' and F'' as well measured slower on llvmpipe (a larger record, the same
+    loop-invariant products)."""
+    n = len(coefficients.outputs) - 1
+    lets = [("vec3", "oc", "ro + sm*rd")]
+    lets += [("real", v.name, f"oc.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
     lets += [("real", v.name, f"rd.{c}") for v, c in zip(DIRECTION, _COMPONENT, strict=True)]
     lets += [("real", s.name, printer.doprint(v)) for s, v in coefficients.assignments]
-    fields = tuple(("real", f"c{k}", f"coefficient of s^{k}")
-                   for k in range(len(coefficients.outputs)))
-    return fields, Code(tuple(lets), tuple(printer.doprint(o) for o in coefficients.outputs))
+    lets += [("real", f"c{k}", printer.doprint(o)) for k, o in enumerate(coefficients.outputs)]
+    size: sympy.Expr = sympy.S.Zero
+    for k in range(n, -1, -1):
+        size = size * _sym("hr") + sympy.Abs(_sym(f"c{k}"))
+    lets.append(("real", "size", printer.doprint(size)))
+    fields = (("real", "sm", "the expansion point: F(s) = sum c_k (s - sm)^k"),
+              ("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"))
+    fields += tuple(("real", f"c{k}", f"coefficient of (s - sm)^{k}") for k in range(n + 1))
+    return fields, Code(tuple(lets), ("sm", "size", *(f"c{k}" for k in range(n + 1))))
+
+
+def _horner_err(expr: sympy.Expr, printer, prefix: str) -> tuple[str, str, str]:
+    """HORNER_ERR: Horner's rounding error on F is below 2n eps sum |c_k| |u|^k (eps:
+    the unit roundoff); twice that, in units of the ray record's `size`."""
+    n = len(coefficient_program(expr).outputs) - 1
+    eps = 2.0**-53 if getattr(printer, "precision", "float") == "double" else 2.0**-24
+    return ("real", prefix.upper() + "HORNER_ERR", printer.float_literal(4 * n * eps))
+
+
+def _value_function(n: int, printer, prefix: str) -> ShaderFunction:
+    """ray_F(ray, u): F at u = s - sm, by Horner where its sign is certain, else at the
+    point (see RAY_DERIVATIVES)."""
+    u = _sym("u")
+    value: sympy.Expr = sympy.S.Zero
+    for k in range(n, -1, -1):
+        value = value * u + _sym(f"ray.c{k}")
+    at_point = f"{prefix}S(ray.o + (u + ray.sm)*ray.d)"
+    bound = f"{prefix.upper()}HORNER_ERR*ray.size"
+    return ShaderFunction(
+        "ray_F", "F at u = s - sm: Horner's value where its sign is certain, else S at the "
+        "point", (("Ray", "ray"), ("real", "u")), "real", (("real", "h", printer.doprint(value)),),
+        (printer.print_select(f"{_abs(printer)}(h) > {bound}", "h", at_point),))
 
 
 def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
     """F^(m)(s) = sum_k k!/(k-m)! c_k s^(k-m), each a Horner sum; the products
     k!/(k-m)! c_k are loop invariant (a compiler hoists them out of the march loop)."""
-    s = _sym("s")
+    s = _sym("u")
     c = [_sym(f"ray.c{k}") for k in range(n + 1)]
     outputs = []
     for q in quantities:
-        m = RAY_DERIVATIVES.index(q)
+        m = _DERIVATIVE_ORDER[q]
         value: sympy.Expr = sympy.S.Zero
         for k in range(n, m - 1, -1):
             value = value * s + sympy.ff(k, m) * c[k]
@@ -325,5 +424,49 @@ def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunc
     what = ", ".join(quantities)
     return ShaderFunction(_ray_name(quantities),
                           f"{what} at ray parameter s: Horner on the ray polynomial",
-                          (("Ray", "ray"), ("real", "s")), _RETURN_TYPE[len(outputs)], (),
-                          tuple(outputs))
+                          (("Ray", "ray"), ("real", "s")), _RETURN_TYPE[len(outputs)],
+                          (("real", "u", "s - ray.sm"),), tuple(outputs))
+
+
+# --- the exact method: root isolation on the ray polynomial ------------------------------
+
+def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
+                  max_derived: int) -> Marcher:
+    """The pieces of templates/solver.j2: S and grad at the point (shading, residual),
+    the ray record with the coefficients, and P_k (k = 1..n), the (n-k)-th derivative of
+    F, a degree-k polynomial in u = s - sm, each one Horner sum."""
+    programs = build_programs(expr, (("S",), ("grad",)), max_derived)
+    functions = [_point_function(name, program, printer) for name, program in programs.items()]
+    coefficients = coefficient_program(expr)
+    n = len(coefficients.outputs) - 1
+    ray_fields, ray = _ray_setup(coefficients, printer)
+    u = _sym("u")
+    c = [_sym(f"ray.c{k}") for k in range(n + 1)]
+    for k in range(1, n + 1):
+        m = n - k  # P_k = F^(m)
+        value: sympy.Expr = sympy.S.Zero
+        for j in range(k, -1, -1):
+            value = value * u + sympy.ff(j + m, m) * c[j + m]
+        what = "F" if m == 0 else "F" + "'" * m if m < 4 else f"F^({m})"
+        if m:  # the derivatives, which only place the pieces: Horner
+            functions.append(ShaderFunction(
+                f"P{k}", f"P{k} = {what}, degree {k} in u = s - sm",
+                (("Ray", "ray"), ("real", "u")), "real", (), (printer.doprint(value),)))
+    # F itself, whose sign is the answer: Horner where that sign is certain, else at the
+    # point (ray_F; see RAY_DERIVATIVES)
+    functions.append(_value_function(n, printer, prefix))
+    functions.append(ShaderFunction(
+        f"P{n}", f"P{n} = F (ray_F)", (("Ray", "ray"), ("real", "u")), "real", (),
+        (f"{prefix}ray_F(ray, u)",)))
+    K = prefix.upper()
+    printed = (("real", K + "TOUCH", printer.float_literal(constants.touch)),
+               _horner_err(expr, printer, prefix),
+               ("real", K + "XTOL", printer.float_literal(constants.xtol)),
+               ("real", K + "CTOL", printer.float_literal(constants.ctol)),
+               ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))))
+    bottom = 2 if n >= 3 else 1
+    m = n - bottom
+    closed = tuple(printer.doprint(sympy.ff(j + m, m) * c[j + m]) for j in range(bottom + 1))
+    empty = Code((), ())
+    return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
+                   empty, Solver(n, bottom, closed))

@@ -43,7 +43,7 @@ RAY_FUNCTIONS = (F, DF, D2F, LAP)
 
 @dataclass(frozen=True)
 class Constants:
-    """Every constant of a marcher; each is a command-line option."""
+    """Every compile-time option of a marcher; each is a command-line option."""
 
     step: float = 0.01  # base step b (Eq. 2)
     tau1: float = 0.01  # |F| <= tau1: near the surface, smaller steps
@@ -55,6 +55,22 @@ class Constants:
     taylor2: str = "paper"
     max_steps: int = 20000  # cap on march steps per ray (a safety bound, not a tuning knob)
     refine_steps: int = 10  # Newton-bisection iterations on the isolated interval
+    # how the ray quantities are computed: "point", "ray-poly" or "auto" (implc/marcher.py)
+    evaluation: str = "auto"
+    # exact: |F| <= touch * sum |c_k| r^k at a critical point is a touching root (r: half
+    # the chord), the relative tolerance of the float64 reference's own touch test, so a
+    # touch is reported only where the reference would report one (1e-9 measured 1-2
+    # false-hit pixels at 512^2 near the double lines of the Cross-Cap, Miter and Roman
+    # surfaces, 1e-8 8-16); Newton stops when its step is below xtol (times 1 + |u|) or
+    # after newton_steps iterations (README "The exact method")
+    touch: float = 1e-12
+    xtol: float = 1e-6
+    # the same for the critical points (roots of F', F'', ...), which only split the ray
+    # into monotonic pieces: placing one off by delta can hide only a pair of roots closer
+    # than delta, a dip of F smaller than |F''| delta^2 / 8 (1e-8 |F''| at 3e-4), below
+    # float32's resolution of F
+    ctol: float = 3e-4
+    newton_steps: int = 16
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -119,13 +135,17 @@ EQ4 = {"paper": EQ4_PAPER, "consistent": EQ4_CONSISTENT, "extremum": EQ4_EXTREMU
 
 @dataclass(frozen=True)
 class Method:
+    """A marching method (sample, step, root), or with `solves` the exact root isolation
+    of the ray polynomial (no marching; templates/solver.j2)."""
+
     name: str
     summary: str
-    sample: tuple[sympy.Expr, sympy.Expr, sympy.Expr]  # (F, F', X) at the march point s
-    step: sympy.Expr  # step length from the start sample (F0, D0, X0)
-    root: Rule | Mapping[str, Rule]  # one rule, or one per --taylor2 reading
+    sample: tuple[sympy.Expr, sympy.Expr, sympy.Expr] = ()  # (F, F', X) at march point s
+    step: sympy.Expr = sympy.S.Zero  # step length from the start sample (F0, D0, X0)
+    root: Rule | Mapping[str, Rule] = Rule(sympy.false)  # one rule, or one per --taylor2
     defaults: Constants = field(default_factory=Constants)
     paper_column: str = ""  # the column of the paper's Table 1 it reproduces ("" if none)
+    solves: bool = False  # exact: polynomial surfaces only
 
     @property
     def reads_taylor2(self) -> bool:
@@ -162,6 +182,9 @@ METHODS: dict[str, Method] = {
                "Eq. 2 steps; Eq. 4 with F'' as a finite difference of F' along the ray",
                (F(S), DF(S), (DF(S + EPS) - DF(S)) / EPS), eq2(F0, D0), EQ4,
                paper_column="Hessian Approximate"),
+        Method("exact", "polynomial S: the first real root of the ray polynomial, isolated "
+               "exactly (monotonic pieces between critical points; no marching)",
+               solves=True),
     )
 }
 

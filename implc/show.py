@@ -6,6 +6,7 @@ import sympy
 
 from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
+from .marcher import AUTO_MAX_DEGREE, coefficient_program, evaluations
 from .methods import Method
 from .surface import Surface
 from .textform import to_text
@@ -31,7 +32,8 @@ def describe(surface: Surface, method: Method) -> str:
         f"  F'(t)      = grad S . D = {_short(d.directional)}",
         f"  F''(t)     = D^T H D = {_short(d.second_directional)}",
         "",
-        f"shader functions for method '{method.name}' (ops before -> after optimization):",
+        f"point form: shader functions for method '{method.name}' (ops before -> after "
+        "optimization):",
     ]
     total_before = total_after = 0
     for name, program in build_functions(surface.expr, method).items():
@@ -43,7 +45,29 @@ def describe(surface: Surface, method: Method) -> str:
         total_before += program.ops_before
         total_after += program.ops_after
     lines.append(f"  total: {total_before} -> {total_after}")
+    lines += _ray_poly_counts(surface, method, degree)
     return "\n".join(lines)
+
+
+def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> list[str]:
+    """The ray-poly form's costs: once per ray (the coefficients) and per march step."""
+    if degree is None:
+        return ["", "ray-poly form: not available (S is not a polynomial)"]
+    coefficients = coefficient_program(surface.expr)
+    quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
+                  for q in qs]
+    horner = {"dS": 2 * (degree - 1) + 1, "d2S": 2 * max(degree - 2, 0) + 1}
+    per_step = ", ".join(f"{q} {horner[q]}" for q in dict.fromkeys(quantities))
+    point = [" + ".join(qs) for kind, qs in evaluations(method, "ray-poly")
+             if kind == "point" and qs not in (("S",), ("grad",))]
+    return [
+        "",
+        f"ray-poly form (chosen by --eval auto up to degree {AUTO_MAX_DEGREE}):",
+        f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
+        f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
+        f"  per evaluation, Horner (multiply-adds counted as 2, plus s - sm): "
+        f"{per_step or 'none'}; F and {', '.join(point) or 'nothing else'} at the point",
+    ]
 
 
 def _short(expr: sympy.Expr, limit: int = 200) -> str:

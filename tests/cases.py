@@ -15,6 +15,8 @@ def golden_cases() -> list[tuple[str, str, str, str]]:
     cases = [(ex, "hessian", fl, "program") for ex in EXAMPLES for fl in GLSL_FLAVORS]
     cases += [(ex, m, "330", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
     cases += [(ex, m, "330", "library") for ex in PAPER for m in ("hessian", "taylor")]
+    cases += [("cross-cap", "exact", fl, "program") for fl in GLSL_FLAVORS if fl != "330"]
+    cases += [("cross-cap", "exact", "330", "library")]
     return cases
 
 
@@ -32,6 +34,7 @@ def opencl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [(ex, m, "float", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
     cases += [(ex, "hessian", "float", "library") for ex in PAPER]
     cases += [("cross-cap", "hessian", "double", "program")]
+    cases += [("cross-cap", "exact", "float", "library"), ("cross-cap", "exact", "double", "program")]
     return cases
 
 
@@ -52,7 +55,7 @@ def wgsl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [(ex, m, "paper", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
     cases += [("cross-cap", m, "consistent", "program") for m in ("hessian", "hessian-approx")]
     cases += [(ex, "hessian", "paper", "library") for ex in PAPER]
-    cases += [("cross-cap", "taylor", "paper", "library")]
+    cases += [("cross-cap", "taylor", "paper", "library"), ("cross-cap", "exact", "paper", "library")]
     return cases
 
 

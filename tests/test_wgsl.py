@@ -127,13 +127,16 @@ def test_every_option_reaches_the_shader():
                                           eps=2e-4, taylor2=taylor2, max_steps=777,
                                           refine_steps=7)
             text = emit(surface, "wgsl", method, c)
-            for line in ("const STEP: f32 = 0.005f;", "const TAU1: f32 = 0.02f;",
-                         "const TAU2: f32 = 0.03f;", "const TAU3: f32 = 0.04f;",
-                         "const MAX_STEPS: i32 = 777;", "const REFINE_STEPS: i32 = 7;"):
+            for line in ("const STEP: f32 = 0.005f;", "const MAX_STEPS: i32 = 777;",
+                         "const REFINE_STEPS: i32 = 7;"):
                 assert line in text, (method, line)
+            # the thresholds are declared where the step rule reads them (not curvature's)
+            for line in ("const TAU1: f32 = 0.02f;", "const TAU2: f32 = 0.03f;",
+                         "const TAU3: f32 = 0.04f;"):
+                assert (line in text) == (method != "curvature"), (method, line)
             assert ("const EPS: f32 = 0.0002f;" in text) == (method == "hessian-approx")
             if method in ("hessian", "hessian-approx"):
-                assert ("0.125f*h*h*f1.z" in text) == (taylor2 == "consistent")
+                assert ("0.125f*f1.z*h*h" in text) == (taylor2 == "consistent")
             name = f"steiner.{method}.{taylor2}.wgsl"
             verdict = validate(text, name)
             assert verdict.ok, verdict.render(name)
@@ -153,8 +156,9 @@ def test_printer_types_literals_and_refuses_what_wgsl_cannot_say():
 
 def test_validator_points_into_the_users_file(monkeypatch):
     text = _emit("cross-cap", "taylor", "paper", "program")
-    line = text.splitlines().index("    let lo = min(min(f0.x, q), min(r, f1.x));") + 1
-    broken = text.replace("min(min(f0.x, q)", "min(min(f0.w, q)")
+    lines = text.splitlines()
+    line = next(i for i, t in enumerate(lines, 1) if "min(f0.x, min(f1.x" in t)
+    broken = text.replace("min(f0.x, min(f1.x", "min(f0.w, min(f1.x")
     verdict = validate(broken, "mine/cc.wgsl")
     assert not verdict.ok
     assert f"mine/cc.wgsl:{line}:" in verdict.messages, verdict.messages

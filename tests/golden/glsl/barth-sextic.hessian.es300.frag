@@ -31,6 +31,15 @@ const int REFINE_STEPS = 10;
 struct Ray {
     vec3 o;  // origin of the march, s = 0
     vec3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
+    float c5;  // coefficient of (s - sm)^5
+    float c6;  // coefficient of (s - sm)^6
 };
 
 struct Hit {
@@ -68,14 +77,28 @@ vec3 grad(vec3 p) {
     return vec3(-t0*x + 20.944271909999163*t1*t2*x - t2*t4*x, -t0*y - 8.0*t1*t2*y + 20.944271909999163*t1*t3*y, -t0*z - t1*t4*z + 20.944271909999163*t2*t3*z);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-vec3 SDH(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+vec2 ray_DH(Ray ray, float s) {
+    float u = s - ray.sm;
+    return vec2(ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + u*(4.0*ray.c4 + u*(5.0*ray.c5 + 6.0*ray.c6*u)))), 2.0*ray.c2 + u*(6.0*ray.c3 + u*(12.0*ray.c4 + u*(20.0*ray.c5 + 30.0*ray.c6*u))));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + u*(4.0*ray.c4 + u*(5.0*ray.c5 + 6.0*ray.c6*u))));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
@@ -86,58 +109,50 @@ vec3 SDH(vec3 p, vec3 d) {
     float t0_2 = t0*t0;
     float t1 = 2.6180339887498953*y_2 - z_2;
     float t2 = 2.6180339887498953*x_2 - y_2;
-    float t3 = -x_2 + 2.6180339887498953*z_2;
+    float t3 = -4.0*x_2 + 10.472135954999581*z_2;
     float t4 = t2*t3;
-    float t5 = 16.94427190999916*t0;
-    float t6 = 8.0*t1;
-    float t7 = t2*t6;
-    float t8 = t3*t6;
-    float t9 = 8.0*t4;
-    float t10 = 33.88854381999832*x;
-    float t11 = x*y;
-    float t12 = 2.0*dx;
-    float t13 = y*z;
-    float t14 = 16.94427190999916*y_2;
-    float t15 = 16.94427190999916*z_2 - 16.94427190999916;
-    float t16 = 16.94427190999916*x_2;
-    return vec3(-4.23606797749979*t0_2 + 4.0*t1*t4, dx*(20.944271909999163*t1*t3*x - t5*x - t7*x) + dy*(20.944271909999163*t2*t3*y - t5*y - t8*y) + dz*(20.944271909999163*t1*t2*z - t5*z - t9*z), dx_2*(20.944271909999163*t1*t3 - 83.77708763999665*t1*x_2 - t14 - t15 - t7 - 50.83281572999748*x_2) + 2.0*dy*dz*(-41.888543819998326*t1*t13 + 109.665631459995*t13*t2 + 16.0*t13*t3 - 33.88854381999832*t13) + dy*t12*(16.0*t1*t11 - t10*y - 41.888543819998326*t11*t2 + 109.665631459995*t11*t3) + dy_2*(-t15 - t16 + 20.944271909999163*t2*t3 - 83.77708763999665*t3*y_2 - t8 - 50.83281572999748*y_2) + dz*t12*(109.665631459995*t1*x*z - t10*z + 16.0*t2*x*z - 41.888543819998326*t3*x*z) + dz_2*(20.944271909999163*t1*t2 - t14 - t16 - 83.77708763999665*t2*z_2 - t9 - 50.83281572999748*z_2 + 16.94427190999916));
-}
-
-// S, dS at the point p along the unit direction d
-vec2 SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float y_2 = y*y;
-    float z_2 = z*z;
-    float t0 = x_2 + y_2 + z_2 - 1.0;
-    float t0_2 = t0*t0;
-    float t1 = -x_2 + 2.6180339887498953*z_2;
-    float t2 = 2.6180339887498953*x_2 - y_2;
-    float t3 = 2.6180339887498953*y_2 - z_2;
-    float t4 = t2*t3;
-    float t5 = 16.94427190999916*t0;
-    return vec2(-4.23606797749979*t0_2 + 4.0*t1*t4, dx*(20.944271909999163*t1*t3*x - 8.0*t4*x - t5*x) + dy*(20.944271909999163*t1*t2*y - 8.0*t1*t3*y - t5*y) + dz*(-8.0*t1*t2*z + 20.944271909999163*t2*t3*z - t5*z));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(vec3 ro, vec3 rd) {
-    return Ray(ro, rd);
+    float t5 = dx*x;
+    float t6 = dy*y;
+    float t7 = 2.0*t6;
+    float t8 = 2.0*dz*z;
+    float t9 = 2.0*t5 + t7 + t8;
+    float t9_2 = t9*t9;
+    float t10 = 8.47213595499958*t0;
+    float t11 = 5.236067977499791*t6 - t8;
+    float t12 = 5.236067977499791*t5 - t7;
+    float t13 = 20.944271909999163*dz*z - 8.0*t5;
+    float t14 = t12*t3 + t13*t2;
+    float t15 = dx_2 + dy_2 + dz_2;
+    float t15_2 = t15*t15;
+    float t16 = 2.6180339887498953*dy_2 - dz_2;
+    float t17 = -4.0*dx_2 + 10.472135954999581*dz_2;
+    float t18 = 2.6180339887498953*dx_2 - dy_2;
+    float t19 = t12*t13 + t17*t2 + t18*t3;
+    float t20 = t12*t17 + t13*t18;
+    float t21 = t17*t18;
+    float c0 = -4.23606797749979*t0_2 + t1*t4;
+    float c1 = t1*t14 - t10*t9 + t11*t4;
+    float c2 = t1*t19 - t10*t15 + t11*t14 + t16*t4 - 4.23606797749979*t9_2;
+    float c3 = t1*t20 + t11*t19 + t14*t16 - 8.47213595499958*t15*t9;
+    float c4 = t1*t21 + t11*t20 - 4.23606797749979*t15_2 + t16*t19;
+    float c5 = t11*t21 + t16*t20;
+    float c6 = t16*t21;
+    float size = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 vec3 values_at(Ray ray, float s) {
-    vec3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return vec3(e0.x, e0.y, e0.z);
+    vec2 e0 = ray_DH(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec3(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -186,7 +201,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = values_at(ray, t0);
     float s1 = t0;
@@ -213,6 +228,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

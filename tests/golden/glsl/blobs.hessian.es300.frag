@@ -171,8 +171,8 @@ vec2 SD(vec3 p, vec3 d) {
     return vec2(-t2 - t5 - t8 + 0.6, dx*(-t2*(4.0 - t10) + 8.0*t5*x - t8*(-t10 - 3.2)) + dy*(8.0*t2*y - t5*(-t11 - 2.4) - t8*(3.2 - t11)) + dz*(t2*t9 - t5*(4.0 - t9) + t8*t9));
 }
 
-// The ray a march runs on: o + s d.
-Ray ray_of(vec3 ro, vec3 rd) {
+// The ray a march runs on: o + s d (sm and hr are not used by the point form).
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     return Ray(ro, rd);
 }
 
@@ -184,7 +184,8 @@ vec3 values_at(Ray ray, float s) {
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    vec2 e0 = SD(ray.o + s*ray.d, ray.d);
+    return vec2(e0.x, e0.y);
 }
 
 // The step length at s, from the sample f0 there.
@@ -233,7 +234,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = values_at(ray, t0);
     float s1 = t0;
@@ -260,6 +261,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

@@ -16,6 +16,12 @@ const int REFINE_STEPS = 10;
 struct Ray {
     vec3 o;  // origin of the march, s = 0
     vec3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
 };
 
 struct Hit {
@@ -56,14 +62,28 @@ vec3 grad(vec3 p) {
     return vec3(-t1 - t2 - 18.0*x + 243.0*x_2 + 54.0*y*z, -t1 - t3 + 54.0*x*z - 18.0*y + 243.0*y_2, -t2 - t3 + 54.0*x*y - 18.0*z + 243.0*z_2 - 9.0);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-vec3 SDH(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+vec2 ray_DH(Ray ray, float s) {
+    float u = s - ray.sm;
+    return vec2(ray.c1 + u*(2.0*ray.c2 + 3.0*ray.c3*u), 2.0*ray.c2 + 6.0*ray.c3*u);
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + 3.0*ray.c3*u);
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float x_3 = x*x_2;
     float y_2 = y*y;
@@ -71,61 +91,46 @@ vec3 SDH(vec3 p, vec3 d) {
     float z_2 = z*z;
     float z_3 = z*z_2;
     float dx_2 = dx*dx;
+    float dx_3 = dx*dx_2;
     float dy_2 = dy*dy;
+    float dy_3 = dy*dy_2;
     float dz_2 = dz*dz;
-    float t0 = 189.0*y_2;
-    float t1 = 189.0*z_2;
-    float t2 = 189.0*x_2;
-    float t3 = 378.0*y;
-    float t4 = t1 + t3*x - 126.0*z + 9.0;
-    float t5 = 378.0*z;
-    float t6 = t0 + t5*x - 126.0*y;
-    float t7 = t2 + t3*z - 126.0*x;
-    float t8 = t5 + 18.0;
-    float t9 = 378.0*x;
-    float t10 = t3 + t9;
-    float t11 = 2.0*dx;
-    return vec3(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0*x*y*z + 126.0*x*y + 126.0*x*z - 9.0*x - 9.0*x_2 + 81.0*x_3 + 126.0*y*z - 9.0*y - 9.0*y_2 + 81.0*y_3 - 9.0*z - 9.0*z_2 + 81.0*z_3 + 1.0, dx*(-t4 - t6 - 18.0*x + 243.0*x_2 + 54.0*y*z) + dy*(-t4 - t7 + 54.0*x*z - 18.0*y + 243.0*y_2) + dz*(-t6 - t7 + 54.0*x*y - 18.0*z + 243.0*z_2 - 9.0), dx_2*(-t3 - t8 + 486.0*x) + 2.0*dy*dz*(-t3 - t5 + 54.0*x + 126.0) + dy*t11*(-t10 + 54.0*z + 126.0) + dy_2*(-t8 - t9 + 486.0*y) + dz*t11*(-t5 - t9 + 54.0*y + 126.0) + dz_2*(-t10 + 486.0*z - 18.0));
-}
-
-// S, dS at the point p along the unit direction d
-vec2 SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float x_3 = x*x_2;
-    float y_2 = y*y;
-    float y_3 = y*y_2;
-    float z_2 = z*z;
-    float z_3 = z*z_2;
-    float t0 = 189.0*y_2;
-    float t1 = 189.0*z_2;
-    float t2 = 189.0*x_2;
-    float t3 = 378.0*x;
-    float t4 = t1 + t3*y - 126.0*z + 9.0;
-    float t5 = t0 + t3*z - 126.0*y;
-    float t6 = t2 - 126.0*x + 378.0*y*z;
-    return vec2(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0*x*y*z + 126.0*x*y + 126.0*x*z - 9.0*x - 9.0*x_2 + 81.0*x_3 + 126.0*y*z - 9.0*y - 9.0*y_2 + 81.0*y_3 - 9.0*z - 9.0*z_2 + 81.0*z_3 + 1.0, dx*(-t4 - t5 - 18.0*x + 243.0*x_2 + 54.0*y*z) + dy*(-t4 - t6 + 54.0*x*z - 18.0*y + 243.0*y_2) + dz*(-t5 - t6 + 54.0*x*y - 18.0*z + 243.0*z_2 - 9.0));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(vec3 ro, vec3 rd) {
-    return Ray(ro, rd);
+    float dz_3 = dz*dz_2;
+    float t0 = 189.0*x;
+    float t1 = 189.0*y;
+    float t2 = 189.0*z;
+    float t3 = dx*x;
+    float t4 = dy*y;
+    float t5 = dz*z;
+    float t6 = 378.0*t3;
+    float t7 = dy*x;
+    float t8 = 378.0*y;
+    float t9 = 378.0*t4;
+    float t10 = 378.0*t5;
+    float t11 = 189.0*dx;
+    float t12 = 189.0*dy;
+    float t13 = 189.0*dz;
+    float t14 = 54.0*dx*y + 54.0*t7;
+    float c0 = -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0*x*y*z + 126.0*x*y + 126.0*x*z - 9.0*x - 9.0*x_2 + 81.0*x_3 + 126.0*y*z - 9.0*y - 9.0*y_2 + 81.0*y_3 - 9.0*z - 9.0*z_2 + 81.0*z_3 + 1.0;
+    float c1 = 243.0*dx*x_2 + 126.0*dx*y + 126.0*dx*z - 9.0*dx + 126.0*dy*x + 243.0*dy*y_2 + 126.0*dy*z - 9.0*dy + 54.0*dz*x*y + 126.0*dz*x + 126.0*dz*y + 243.0*dz*z_2 - 9.0*dz - t10*x - t11*y_2 - t11*z_2 - t12*x_2 - t12*z_2 - t13*x_2 - t13*y_2 + t14*z - 18.0*t3 - 18.0*t4 - t5*t8 - 18.0*t5 - t6*y - t6*z - t7*t8 - t9*z;
+    float c2 = 54.0*dx*dy*z + 126.0*dx*dy + 126.0*dx*dz - dx*t10 - 378.0*dx*t7 - dx*t9 - dx_2*t1 - dx_2*t2 + 243.0*dx_2*x - 9.0*dx_2 + 126.0*dy*dz - dy*t10 - dy_2*t0 - dy_2*t2 + 243.0*dy_2*y - 9.0*dy_2 + dz*t14 - dz*t6 - dz*t9 - dz_2*t0 - dz_2*t1 + 243.0*dz_2*z - 9.0*dz_2;
+    float c3 = 54.0*dx*dy*dz - dx_2*t12 - dx_2*t13 + 81.0*dx_3 - dy_2*t11 - dy_2*t13 + 81.0*dy_3 - dz_2*t11 - dz_2*t12 + 81.0*dz_3;
+    float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 vec3 values_at(Ray ray, float s) {
-    vec3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return vec3(e0.x, e0.y, e0.z);
+    vec2 e0 = ray_DH(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec3(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -174,7 +179,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = values_at(ray, t0);
     float s1 = t0;
@@ -201,6 +206,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

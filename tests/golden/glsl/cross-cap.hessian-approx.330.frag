@@ -29,6 +29,13 @@ const int REFINE_STEPS = 10;
 struct Ray {
     vec3 o;  // origin of the march, s = 0
     vec3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
 };
 
 struct Hit {
@@ -64,60 +71,62 @@ vec3 grad(vec3 p) {
     return vec3(8.0*x*(t0 + x_2 + z) + 8.0*x_3, 8.0*x_2*y + 2.0*y*(t0 - 1.0) + 2.0*y_3, t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
-// S, dS at the point p along the unit direction d
-vec2 SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
-    float x_3 = x*x_2;
     float y_2 = y*y;
-    float y_3 = y*y_2;
     float z_2 = z*z;
+    float dx_2 = dx*dx;
+    float dy_2 = dy*dy;
+    float dz_2 = dz*dz;
     float t0 = y_2 + z_2;
     float t1 = t0 - 1.0;
     float t2 = t0 + x_2 + z;
     float t3 = 4.0*x_2;
-    float t4 = 2.0*z;
-    return vec2(t1*y_2 + t2*t3, dx*(8.0*t2*x + 8.0*x_3) + dy*(2.0*t1*y + 8.0*x_2*y + 2.0*y_3) + dz*(t3*(t4 + 1.0) + t4*y_2));
-}
-
-// dS at the point p along the unit direction d
-float dS(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float x_3 = x*x_2;
-    float y_2 = y*y;
-    float y_3 = y*y_2;
-    float z_2 = z*z;
-    float t0 = 2.0*z;
-    float t1 = y_2 + z_2;
-    return dx*(8.0*x*(t1 + x_2 + z) + 8.0*x_3) + dy*(8.0*x_2*y + 2.0*y*(t1 - 1.0) + 2.0*y_3) + dz*(t0*y_2 + 4.0*x_2*(t0 + 1.0));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(vec3 ro, vec3 rd) {
-    return Ray(ro, rd);
+    float t4 = 2.0*dy*y;
+    float t5 = 2.0*dz*z + t4;
+    float t6 = dx*x;
+    float t7 = 8.0*t6;
+    float t8 = dz + t5 + 2.0*t6;
+    float t9 = dy_2 + dz_2;
+    float t10 = dx_2 + t9;
+    float t11 = 4.0*dx_2;
+    float c0 = t1*y_2 + t2*t3;
+    float c1 = t1*t4 + t2*t7 + t3*t8 + t5*y_2;
+    float c2 = dy_2*t1 + t10*t3 + t11*t2 + t4*t5 + t7*t8 + t9*y_2;
+    float c3 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
+    float c4 = dy_2*t9 + t10*t11;
+    float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 vec3 values_at(Ray ray, float s) {
-    vec2 e0 = SD(ray.o + s*ray.d, ray.d);
-    float e1 = dS(ray.o + (EPS + s)*ray.d, ray.d);
-    return vec3(e0.x, e0.y, (-e0.y + e1)/EPS);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    float e2 = ray_dS(ray, EPS + s);
+    return vec3(e1, e0, (-e0 + e2)/EPS);
 }
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -166,7 +175,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = values_at(ray, t0);
     float s1 = t0;
@@ -193,6 +202,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

@@ -31,6 +31,15 @@ const int REFINE_STEPS = 10;
 struct Ray {
     vec3 o;  // origin of the march, s = 0
     vec3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
+    float c5;  // coefficient of (s - sm)^5
+    float c6;  // coefficient of (s - sm)^6
 };
 
 struct Hit {
@@ -68,14 +77,28 @@ vec3 grad(vec3 p) {
     return vec3(6.0*t0_2*x - 2.0*x*z_3, 13.5*t0_2*y - 0.225*y*z_3, 6.0*t0_2*z - 3.0*x_2*z_2 - 0.3375*y_2*z_2);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-vec3 SDH(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+vec2 ray_DH(Ray ray, float s) {
+    float u = s - ray.sm;
+    return vec2(ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + u*(4.0*ray.c4 + u*(5.0*ray.c5 + 6.0*ray.c6*u)))), 2.0*ray.c2 + u*(6.0*ray.c3 + u*(12.0*ray.c4 + u*(20.0*ray.c5 + 30.0*ray.c6*u))));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + u*(4.0*ray.c4 + u*(5.0*ray.c5 + 6.0*ray.c6*u))));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
@@ -83,47 +106,53 @@ vec3 SDH(vec3 p, vec3 d) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = x_2 + 2.25*y_2 + z_2 - 1.0;
-    float t0_2 = t0*t0;
-    float t0_3 = t0*t0_2;
-    float t1 = 2.0*z_3;
-    float t2 = 0.225*z_3;
-    float t3 = 2.0*dz;
-    return vec3(t0_3 - x_2*z_3 - 0.1125*y_2*z_3, dx*(6.0*t0_2*x - t1*x) + dy*(13.5*t0_2*y - t2*y) + dz*(6.0*t0_2*z - 3.0*x_2*z_2 - 0.3375*y_2*z_2), 108.0*dx*dy*t0*x*y + dx*t3*(24.0*t0*x*z - 6.0*x*z_2) + dx_2*(24.0*t0*x_2 + 6.0*t0_2 - t1) + dy*t3*(54.0*t0*y*z - 0.675*y*z_2) + dy_2*(121.5*t0*y_2 + 13.5*t0_2 - t2) + dz_2*(24.0*t0*z_2 + 6.0*t0_2 - 6.0*x_2*z - 0.675*y_2*z));
-}
-
-// S, dS at the point p along the unit direction d
-vec2 SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float y_2 = y*y;
-    float z_2 = z*z;
-    float z_3 = z*z_2;
-    float t0 = x_2 + 2.25*y_2 + z_2 - 1.0;
-    float t0_2 = t0*t0;
-    float t0_3 = t0*t0_2;
-    return vec2(t0_3 - x_2*z_3 - 0.1125*y_2*z_3, dx*(6.0*t0_2*x - 2.0*x*z_3) + dy*(13.5*t0_2*y - 0.225*y*z_3) + dz*(6.0*t0_2*z - 3.0*x_2*z_2 - 0.3375*y_2*z_2));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(vec3 ro, vec3 rd) {
-    return Ray(ro, rd);
+    float dz_3 = dz*dz_2;
+    float t0 = 0.1125*z_3;
+    float t1 = x_2 + 2.25*y_2 + z_2 - 1.0;
+    float t1_2 = t1*t1;
+    float t1_3 = t1*t1_2;
+    float t2 = dx*x;
+    float t3 = 2.0*t2;
+    float t4 = dy*y;
+    float t5 = 0.225*t4;
+    float t6 = dz*z_2;
+    float t7 = 3.0*x_2;
+    float t8 = 0.3375*y_2;
+    float t9 = 2.0*dz*z + t3 + 4.5*t4;
+    float t9_2 = t9*t9;
+    float t10 = 6.0*t2;
+    float t11 = 0.675*t4;
+    float t12 = dz_2*z;
+    float t13 = dx_2 + 2.25*dy_2 + dz_2;
+    float t13_2 = t13*t13;
+    float t13_3 = t13*t13_2;
+    float t14 = 2.0*t1*t13 + t9_2;
+    float t15 = 0.1125*dz_3;
+    float t16 = 3.0*dx_2;
+    float t17 = 0.3375*dy_2;
+    float c0 = -t0*y_2 + t1_3 - x_2*z_3;
+    float c1 = 3.0*t1_2*t9 - t3*z_3 - t5*z_3 - t6*t7 - t6*t8;
+    float c2 = -dx_2*z_3 - dy_2*t0 + t1*t14 + 2.0*t1*t9_2 - t10*t6 - t11*t6 - t12*t7 - t12*t8 + t13*t1_2;
+    float c3 = -dz_3*x_2 + 4.0*t1*t13*t9 - t10*t12 - t11*t12 + t14*t9 - t15*y_2 - t16*t6 - t17*t6;
+    float c4 = -dz_3*t3 - dz_3*t5 + t1*t13_2 - t12*t16 - t12*t17 + t13*t14 + 2.0*t13*t9_2;
+    float c5 = -dx_2*dz_3 - dy_2*t15 + 3.0*t13_2*t9;
+    float c6 = t13_3;
+    float size = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 vec3 values_at(Ray ray, float s) {
-    vec3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return vec3(e0.x, e0.y, e0.z);
+    vec2 e0 = ray_DH(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec3(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -172,7 +201,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = values_at(ray, t0);
     float s1 = t0;
@@ -199,6 +228,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

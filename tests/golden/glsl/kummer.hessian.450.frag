@@ -28,6 +28,13 @@ const int REFINE_STEPS = 10;
 struct Ray {
     vec3 o;  // origin of the march, s = 0
     vec3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
 };
 
 struct Hit {
@@ -79,14 +86,28 @@ vec3 grad(vec3 p) {
     return vec3(t0*x - t1*t11 + t1*t9, t0*y + t1*t13 - t1*t14, t0*z + t11 - t13 - t14 + t9);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-vec3 SDH(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+vec2 ray_DH(Ray ray, float s) {
+    float u = s - ray.sm;
+    return vec2(ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u)), 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
@@ -96,86 +117,52 @@ vec3 SDH(vec3 p, vec3 d) {
     float t0 = x_2 + y_2 + z_2 - 1.3;
     float t0_2 = t0*t0;
     float t1 = 1.4142135623730951;
-    float t2 = t1*y;
-    float t3 = z + 1.0;
-    float t4 = t2 + t3;
-    float t5 = -t2 + t3;
-    float t6 = t4*t5;
-    float t7 = t1*x;
-    float t8 = t7 - z + 1.0;
-    float t9 = -t7 - z + 1.0;
-    float t10 = t8*t9;
-    float t11 = 1.7058823529411766*t10;
-    float t12 = 4.0*t0;
-    float t13 = 1.7058823529411766*t6;
-    float t14 = t13*t8;
-    float t15 = t13*t9;
-    float t16 = t11*t4;
-    float t17 = t11*t5;
-    float t18 = 4.0*y_2;
-    float t19 = 4.0*z_2 - 5.2;
-    float t20 = 4.0*x_2;
-    float t21 = 8.0*x;
-    float t22 = 3.4117647058823533*t4;
-    float t23 = t22*t8;
-    float t24 = 3.4117647058823533*t5;
-    float t25 = t24*t9;
-    float t26 = t22*t9 + t24*t8;
-    float t27 = 2.0*dx;
-    float t28 = 1.7058823529411766*t1;
-    float t29 = t28*t9;
-    float t30 = t29*t5;
-    float t31 = t28*t8;
-    float t32 = t31*t4;
-    float t33 = -t29*t4 + t31*t5;
-    return vec3(t0_2 - t11*t6, dx*(t1*t14 - t1*t15 + t12*x) + dy*(t1*t16 - t1*t17 + t12*y) + dz*(t12*z + t14 + t15 - t16 - t17), dx_2*(t18 + t19 + 6.8235294117647065*t6 + 12.0*x_2) + 2.0*dy*dz*(t30 - t32 + t33 + 8.0*y*z) + dy*t27*(t21*y - t23 - t25 + t26) + dy_2*(6.8235294117647065*t10 + t19 + t20 + 12.0*y_2) + dz*t27*(t21*z - t30 + t32 + t33) + dz_2*(-3.4117647058823533*t10 + t18 + t20 + t23 + t25 + t26 - 3.4117647058823533*t6 + 12.0*z_2 - 5.2));
-}
-
-// S, dS at the point p along the unit direction d
-vec2 SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float y_2 = y*y;
-    float z_2 = z*z;
-    float t0 = x_2 + y_2 + z_2 - 1.3;
-    float t0_2 = t0*t0;
-    float t1 = 1.4142135623730951;
-    float t2 = t1*y;
-    float t3 = z + 1.0;
-    float t4 = -t2 + t3;
-    float t5 = t2 + t3;
-    float t6 = t1*x;
-    float t7 = t6 - z + 1.0;
-    float t8 = -t6 - z + 1.0;
-    float t9 = 1.7058823529411766*t7*t8;
-    float t10 = t5*t9;
-    float t11 = 4.0*t0;
-    float t12 = 1.7058823529411766*t4*t5;
-    float t13 = t12*t7;
-    float t14 = t12*t8;
-    float t15 = t4*t9;
-    return vec2(t0_2 - t10*t4, dx*(t1*t13 - t1*t14 + t11*x) + dy*(t1*t10 - t1*t15 + t11*y) + dz*(-t10 + t11*z + t13 + t14 - t15));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(vec3 ro, vec3 rd) {
-    return Ray(ro, rd);
+    float t2 = t1*x;
+    float t3 = -t2 - z + 1.0;
+    float t4 = t2 - z + 1.0;
+    float t5 = t1*y;
+    float t6 = -1.7058823529411766*t5 - 1.7058823529411766*z - 1.7058823529411766;
+    float t7 = -t5 + z + 1.0;
+    float t8 = t6*t7;
+    float t9 = t4*t8;
+    float t10 = 2.0*dx*x + 2.0*dy*y + 2.0*dz*z;
+    float t10_2 = t10*t10;
+    float t11 = 2.0*t0;
+    float t12 = dx*t1;
+    float t13 = -dz - t12;
+    float t14 = -dz;
+    float t15 = t12 + t14;
+    float t16 = dy*t1;
+    float t17 = -1.7058823529411766*dz - 1.7058823529411766*t16;
+    float t18 = -t14 - t16;
+    float t19 = t17*t7 + t18*t6;
+    float t20 = t15*t8 + t19*t4;
+    float t21 = dx_2 + dy_2 + dz_2;
+    float t21_2 = t21*t21;
+    float t22 = t17*t18;
+    float t23 = t15*t19 + t22*t4;
+    float t24 = t15*t22;
+    float c0 = t0_2 + t3*t9;
+    float c1 = t10*t11 + t13*t9 + t20*t3;
+    float c2 = t10_2 + t11*t21 + t13*t20 + t23*t3;
+    float c3 = 2.0*t10*t21 + t13*t23 + t24*t3;
+    float c4 = t13*t24 + t21_2;
+    float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 vec3 values_at(Ray ray, float s) {
-    vec3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return vec3(e0.x, e0.y, e0.z);
+    vec2 e0 = ray_DH(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec3(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -224,7 +211,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = values_at(ray, t0);
     float s1 = t0;
@@ -251,6 +238,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

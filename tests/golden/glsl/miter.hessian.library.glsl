@@ -23,6 +23,13 @@ const int MITER_REFINE_STEPS = 10;
 struct miter_Ray {
     vec3 o;  // origin of the march, s = 0
     vec3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
 };
 
 struct miter_Hit {
@@ -58,67 +65,69 @@ vec3 miter_grad(vec3 p) {
     return vec3(8.0*x*(t0 + x_2) + 8.0*x_3, t1*y - 2.0*y*(1.0 - t0) + 2.0*y_3, t1*z + 2.0*y_2*z);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-vec3 miter_SDH(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+vec2 miter_ray_DH(miter_Ray ray, float s) {
+    float u = s - ray.sm;
+    return vec2(ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u)), 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float miter_ray_dS(miter_Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+miter_Ray miter_ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
-    float x_3 = x*x_2;
     float y_2 = y*y;
-    float y_3 = y*y_2;
     float z_2 = z*z;
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
     float t0 = y_2 + z_2;
     float t1 = t0 + x_2;
-    float t2 = 1.0 - t0;
-    float t3 = 8.0*x_2;
-    float t4 = 2.0*y_2;
-    float t5 = dy*y;
-    float t6 = 32.0*dx*x;
-    float t7 = dz*z;
-    return vec3(4.0*t1*x_2 - t2*y_2, dx*(8.0*t1*x + 8.0*x_3) + dy*(-2.0*t2*y + t3*y + 2.0*y_3) + dz*(t3*z + t4*z), dx_2*(48.0*x_2 + 8.0*y_2 + 8.0*z_2) + dy_2*(t3 + 12.0*y_2 + 2.0*z_2 - 2.0) + dz_2*(t3 + t4) + t5*t6 + 8.0*t5*t7 + t6*t7);
-}
-
-// S, dS at the point p along the unit direction d
-vec2 miter_SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float x_3 = x*x_2;
-    float y_2 = y*y;
-    float y_3 = y*y_2;
-    float z_2 = z*z;
-    float t0 = y_2 + z_2;
-    float t1 = t0 + x_2;
-    float t2 = 1.0 - t0;
-    float t3 = 8.0*x_2;
-    return vec2(4.0*t1*x_2 - t2*y_2, dx*(8.0*t1*x + 8.0*x_3) + dy*(-2.0*t2*y + t3*y + 2.0*y_3) + dz*(t3*z + 2.0*y_2*z));
-}
-
-// The ray a march runs on: o + s d.
-miter_Ray miter_ray_of(vec3 ro, vec3 rd) {
-    return miter_Ray(ro, rd);
+    float t2 = 4.0*x_2;
+    float t3 = 1.0 - t0;
+    float t4 = 2.0*dy*y;
+    float t5 = 2.0*dz*z + t4;
+    float t6 = -t5;
+    float t7 = dx*x;
+    float t8 = 8.0*t7;
+    float t9 = t5 + 2.0*t7;
+    float t10 = 4.0*dx_2;
+    float t11 = dy_2 + dz_2;
+    float t12 = dx_2 + t11;
+    float t13 = -t11;
+    float c0 = t1*t2 - t3*y_2;
+    float c1 = t1*t8 + t2*t9 - t3*t4 - t6*y_2;
+    float c2 = -dy_2*t3 + t1*t10 + t12*t2 - t13*y_2 - t4*t6 + t8*t9;
+    float c3 = -dy_2*t6 + t10*t9 + t12*t8 - t13*t4;
+    float c4 = -dy_2*t13 + t10*t12;
+    float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return miter_Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 vec3 miter_values_at(miter_Ray ray, float s) {
-    vec3 e0 = miter_SDH(ray.o + s*ray.d, ray.d);
-    return vec3(e0.x, e0.y, e0.z);
+    vec2 e0 = miter_ray_DH(ray, s);
+    float e1 = miter_S(ray.o + s*ray.d);
+    return vec3(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 vec2 miter_fd(miter_Ray ray, float s) {
-    return miter_SD(ray.o + s*ray.d, ray.d);
+    float e0 = miter_ray_dS(ray, s);
+    float e1 = miter_S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -167,7 +176,7 @@ float miter_refine(miter_Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 miter_Hit miter_trace(vec3 ro, vec3 rd, float t0, float t1) {
-    miter_Ray ray = miter_ray_of(ro, rd);
+    miter_Ray ray = miter_ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = miter_values_at(ray, t0);
     float s1 = t0;
@@ -194,6 +203,7 @@ miter_Hit miter_trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return miter_Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

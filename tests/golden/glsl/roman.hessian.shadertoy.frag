@@ -16,6 +16,13 @@ const int REFINE_STEPS = 10;
 struct Ray {
     vec3 o;  // origin of the march, s = 0
     vec3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
 };
 
 struct Hit {
@@ -49,62 +56,70 @@ vec3 grad(vec3 p) {
     return vec3(t0*y_2 + t0*z_2 - y*z, t1*x_2 + t1*z_2 - x*z, t2*x_2 + t2*y_2 - x*y);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-vec3 SDH(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+vec2 ray_DH(Ray ray, float s) {
+    float u = s - ray.sm;
+    return vec2(ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u)), 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = y*z;
+    float t0 = x*y;
     float t1 = 2.0*y_2;
-    float t2 = 2.0*z_2;
-    float t3 = x*z;
-    float t4 = 2.0*x_2;
-    float t5 = x*y;
-    float t6 = 2.0*dx;
-    return vec3(-t0*x + x_2*y_2 + x_2*z_2 + y_2*z_2, dx*(-t0 + t1*x + t2*x) + dy*(t2*y - t3 + t4*y) + dz*(t1*z + t4*z - t5), dx_2*(t1 + t2) + 2.0*dy*dz*(-x + 4.0*y*z) + dy*t6*(4.0*t5 - z) + dy_2*(t2 + t4) + dz*t6*(4.0*t3 - y) + dz_2*(t1 + t4));
-}
-
-// S, dS at the point p along the unit direction d
-vec2 SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float y_2 = y*y;
-    float z_2 = z*z;
-    float t0 = y*z;
-    float t1 = 2.0*x;
-    float t2 = 2.0*y;
-    float t3 = 2.0*z;
-    return vec2(-t0*x + x_2*y_2 + x_2*z_2 + y_2*z_2, dx*(-t0 + t1*y_2 + t1*z_2) + dy*(t2*x_2 + t2*z_2 - x*z) + dz*(t3*x_2 + t3*y_2 - x*y));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(vec3 ro, vec3 rd) {
-    return Ray(ro, rd);
+    float t2 = dx*x;
+    float t3 = 2.0*z_2;
+    float t4 = dy*y;
+    float t5 = 2.0*x_2;
+    float t6 = dz*z;
+    float t7 = dx*y;
+    float t8 = dy*x;
+    float t9 = -t7 - t8;
+    float t10 = dx*dy;
+    float t11 = 4.0*t6;
+    float t12 = 2.0*t2;
+    float t13 = 2.0*t4;
+    float t14 = 2.0*t6;
+    float c0 = -t0*z + x_2*y_2 + x_2*z_2 + y_2*z_2;
+    float c1 = -dz*t0 + t1*t2 + t1*t6 + t2*t3 + t3*t4 + t4*t5 + t5*t6 + t9*z;
+    float c2 = dx_2*y_2 + dx_2*z_2 + dy_2*x_2 + dy_2*z_2 + dz*t9 + dz_2*x_2 + dz_2*y_2 - t10*z + t11*t2 + t11*t4 + 4.0*t7*t8;
+    float c3 = dx_2*t13 + dx_2*t14 + dy_2*t12 + dy_2*t14 - dz*t10 + dz_2*t12 + dz_2*t13;
+    float c4 = dx_2*dy_2 + dx_2*dz_2 + dy_2*dz_2;
+    float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 vec3 values_at(Ray ray, float s) {
-    vec3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return vec3(e0.x, e0.y, e0.z);
+    vec2 e0 = ray_DH(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec3(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -153,7 +168,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float s = t0;
     vec3 f = values_at(ray, t0);
     float s1 = t0;
@@ -180,6 +195,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in t (t1 when there is none) and the march steps taken in steps.

@@ -29,6 +29,15 @@ __constant int REFINE_STEPS = 10;
 typedef struct {
     float3 o;  // origin of the march, s = 0
     float3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
+    float c5;  // coefficient of (s - sm)^5
+    float c6;  // coefficient of (s - sm)^6
 } Ray;
 
 typedef struct {
@@ -66,14 +75,28 @@ float3 grad(float3 p) {
     return (float3)(-t0*x + 20.944271909999163f*t1*t2*x - t2*t4*x, -t0*y - 8.0f*t1*t2*y + 20.944271909999163f*t1*t3*y, -t0*z - t1*t4*z + 20.944271909999163f*t2*t3*z);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-float3 SDH(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+float2 ray_DH(Ray ray, float s) {
+    float u = s - ray.sm;
+    return (float2)(ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + u*(4.0f*ray.c4 + u*(5.0f*ray.c5 + 6.0f*ray.c6*u)))), 2.0f*ray.c2 + u*(6.0f*ray.c3 + u*(12.0f*ray.c4 + u*(20.0f*ray.c5 + 30.0f*ray.c6*u))));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + u*(4.0f*ray.c4 + u*(5.0f*ray.c5 + 6.0f*ray.c6*u))));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
+    float3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
@@ -84,58 +107,50 @@ float3 SDH(float3 p, float3 d) {
     float t0_2 = t0*t0;
     float t1 = 2.6180339887498953f*y_2 - z_2;
     float t2 = 2.6180339887498953f*x_2 - y_2;
-    float t3 = -x_2 + 2.6180339887498953f*z_2;
+    float t3 = -4.0f*x_2 + 10.472135954999581f*z_2;
     float t4 = t2*t3;
-    float t5 = 16.94427190999916f*t0;
-    float t6 = 8.0f*t1;
-    float t7 = t2*t6;
-    float t8 = t3*t6;
-    float t9 = 8.0f*t4;
-    float t10 = 33.88854381999832f*x;
-    float t11 = x*y;
-    float t12 = 2.0f*dx;
-    float t13 = y*z;
-    float t14 = 16.94427190999916f*y_2;
-    float t15 = 16.94427190999916f*z_2 - 16.94427190999916f;
-    float t16 = 16.94427190999916f*x_2;
-    return (float3)(-4.23606797749979f*t0_2 + 4.0f*t1*t4, dx*(20.944271909999163f*t1*t3*x - t5*x - t7*x) + dy*(20.944271909999163f*t2*t3*y - t5*y - t8*y) + dz*(20.944271909999163f*t1*t2*z - t5*z - t9*z), dx_2*(20.944271909999163f*t1*t3 - 83.77708763999665f*t1*x_2 - t14 - t15 - t7 - 50.83281572999748f*x_2) + 2.0f*dy*dz*(-41.888543819998326f*t1*t13 + 109.665631459995f*t13*t2 + 16.0f*t13*t3 - 33.88854381999832f*t13) + dy*t12*(16.0f*t1*t11 - t10*y - 41.888543819998326f*t11*t2 + 109.665631459995f*t11*t3) + dy_2*(-t15 - t16 + 20.944271909999163f*t2*t3 - 83.77708763999665f*t3*y_2 - t8 - 50.83281572999748f*y_2) + dz*t12*(109.665631459995f*t1*x*z - t10*z + 16.0f*t2*x*z - 41.888543819998326f*t3*x*z) + dz_2*(20.944271909999163f*t1*t2 - t14 - t16 - 83.77708763999665f*t2*z_2 - t9 - 50.83281572999748f*z_2 + 16.94427190999916f));
-}
-
-// S, dS at the point p along the unit direction d
-float2 SD(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float y_2 = y*y;
-    float z_2 = z*z;
-    float t0 = x_2 + y_2 + z_2 - 1.0f;
-    float t0_2 = t0*t0;
-    float t1 = -x_2 + 2.6180339887498953f*z_2;
-    float t2 = 2.6180339887498953f*x_2 - y_2;
-    float t3 = 2.6180339887498953f*y_2 - z_2;
-    float t4 = t2*t3;
-    float t5 = 16.94427190999916f*t0;
-    return (float2)(-4.23606797749979f*t0_2 + 4.0f*t1*t4, dx*(20.944271909999163f*t1*t3*x - 8.0f*t4*x - t5*x) + dy*(20.944271909999163f*t1*t2*y - 8.0f*t1*t3*y - t5*y) + dz*(-8.0f*t1*t2*z + 20.944271909999163f*t2*t3*z - t5*z));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(float3 ro, float3 rd) {
-    return (Ray){ro, rd};
+    float t5 = dx*x;
+    float t6 = dy*y;
+    float t7 = 2.0f*t6;
+    float t8 = 2.0f*dz*z;
+    float t9 = 2.0f*t5 + t7 + t8;
+    float t9_2 = t9*t9;
+    float t10 = 8.47213595499958f*t0;
+    float t11 = 5.236067977499791f*t6 - t8;
+    float t12 = 5.236067977499791f*t5 - t7;
+    float t13 = 20.944271909999163f*dz*z - 8.0f*t5;
+    float t14 = t12*t3 + t13*t2;
+    float t15 = dx_2 + dy_2 + dz_2;
+    float t15_2 = t15*t15;
+    float t16 = 2.6180339887498953f*dy_2 - dz_2;
+    float t17 = -4.0f*dx_2 + 10.472135954999581f*dz_2;
+    float t18 = 2.6180339887498953f*dx_2 - dy_2;
+    float t19 = t12*t13 + t17*t2 + t18*t3;
+    float t20 = t12*t17 + t13*t18;
+    float t21 = t17*t18;
+    float c0 = -4.23606797749979f*t0_2 + t1*t4;
+    float c1 = t1*t14 - t10*t9 + t11*t4;
+    float c2 = t1*t19 - t10*t15 + t11*t14 + t16*t4 - 4.23606797749979f*t9_2;
+    float c3 = t1*t20 + t11*t19 + t14*t16 - 8.47213595499958f*t15*t9;
+    float c4 = t1*t21 + t11*t20 - 4.23606797749979f*t15_2 + t16*t19;
+    float c5 = t11*t21 + t16*t20;
+    float c6 = t16*t21;
+    float size = hr*(hr*(hr*(hr*(hr*(hr*fabs(c6) + fabs(c5)) + fabs(c4)) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
+    return (Ray){ro, rd, sm, size, c0, c1, c2, c3, c4, c5, c6};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 float3 values_at(Ray ray, float s) {
-    float3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return (float3)(e0.x, e0.y, e0.z);
+    float2 e0 = ray_DH(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return (float3)(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 float2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return (float2)(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -184,7 +199,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(float3 ro, float3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     float s = t0;
     float3 f = values_at(ray, t0);
     float s1 = t0;
@@ -211,6 +226,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     }
     return (Hit){found, t, steps};
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in *t (t1 when there is none) and the march steps taken in *steps.

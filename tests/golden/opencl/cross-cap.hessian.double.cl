@@ -30,6 +30,13 @@ __constant int REFINE_STEPS = 10;
 typedef struct {
     double3 o;  // origin of the march, s = 0
     double3 d;  // unit direction
+    double sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    double size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    double c0;  // coefficient of (s - sm)^0
+    double c1;  // coefficient of (s - sm)^1
+    double c2;  // coefficient of (s - sm)^2
+    double c3;  // coefficient of (s - sm)^3
+    double c4;  // coefficient of (s - sm)^4
 } Ray;
 
 typedef struct {
@@ -65,18 +72,30 @@ double3 grad(double3 p) {
     return (double3)(8.0*x*(t0 + x_2 + z) + 8.0*x_3, 8.0*x_2*y + 2.0*y*(t0 - 1.0) + 2.0*y_3, t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
-// S, dS, d2S at the point p along the unit direction d
-double3 SDH(double3 p, double3 d) {
-    double x = p.x;
-    double y = p.y;
-    double z = p.z;
-    double dx = d.x;
-    double dy = d.y;
-    double dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+double2 ray_DH(Ray ray, double s) {
+    double u = s - ray.sm;
+    return (double2)(ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u)), 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+double ray_dS(Ray ray, double s) {
+    double u = s - ray.sm;
+    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
+    double3 oc = ro + sm*rd;
+    double x = oc.x;
+    double y = oc.y;
+    double z = oc.z;
+    double dx = rd.x;
+    double dy = rd.y;
+    double dz = rd.z;
     double x_2 = x*x;
-    double x_3 = x*x_2;
     double y_2 = y*y;
-    double y_3 = y*y_2;
     double z_2 = z*z;
     double dx_2 = dx*dx;
     double dy_2 = dy*dy;
@@ -85,50 +104,35 @@ double3 SDH(double3 p, double3 d) {
     double t1 = t0 - 1.0;
     double t2 = t0 + x_2 + z;
     double t3 = 4.0*x_2;
-    double t4 = 2.0*z;
-    double t5 = t4 + 1.0;
-    double t6 = 8.0*x_2;
-    double t7 = dy*y;
-    double t8 = dx*x;
-    double t9 = 8.0*z;
-    return (double3)(t1*y_2 + t2*t3, dx*(8.0*t2*x + 8.0*x_3) + dy*(2.0*t1*y + t6*y + 2.0*y_3) + dz*(t3*t5 + t4*y_2), dx_2*(t9 + 48.0*x_2 + 8.0*y_2 + 8.0*z_2) + dy_2*(t6 + 12.0*y_2 + 2.0*z_2 - 2.0) + 16.0*dz*t5*t8 + dz*t7*t9 + dz_2*(t6 + 2.0*y_2) + 32.0*t7*t8);
-}
-
-// S, dS at the point p along the unit direction d
-double2 SD(double3 p, double3 d) {
-    double x = p.x;
-    double y = p.y;
-    double z = p.z;
-    double dx = d.x;
-    double dy = d.y;
-    double dz = d.z;
-    double x_2 = x*x;
-    double x_3 = x*x_2;
-    double y_2 = y*y;
-    double y_3 = y*y_2;
-    double z_2 = z*z;
-    double t0 = y_2 + z_2;
-    double t1 = t0 - 1.0;
-    double t2 = t0 + x_2 + z;
-    double t3 = 4.0*x_2;
-    double t4 = 2.0*z;
-    return (double2)(t1*y_2 + t2*t3, dx*(8.0*t2*x + 8.0*x_3) + dy*(2.0*t1*y + 8.0*x_2*y + 2.0*y_3) + dz*(t3*(t4 + 1.0) + t4*y_2));
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(double3 ro, double3 rd) {
-    return (Ray){ro, rd};
+    double t4 = 2.0*dy*y;
+    double t5 = 2.0*dz*z + t4;
+    double t6 = dx*x;
+    double t7 = 8.0*t6;
+    double t8 = dz + t5 + 2.0*t6;
+    double t9 = dy_2 + dz_2;
+    double t10 = dx_2 + t9;
+    double t11 = 4.0*dx_2;
+    double c0 = t1*y_2 + t2*t3;
+    double c1 = t1*t4 + t2*t7 + t3*t8 + t5*y_2;
+    double c2 = dy_2*t1 + t10*t3 + t11*t2 + t4*t5 + t7*t8 + t9*y_2;
+    double c3 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
+    double c4 = dy_2*t9 + t10*t11;
+    double size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
+    return (Ray){ro, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 double3 values_at(Ray ray, double s) {
-    double3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return (double3)(e0.x, e0.y, e0.z);
+    double2 e0 = ray_DH(ray, s);
+    double e1 = S(ray.o + s*ray.d);
+    return (double3)(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 double2 fd(Ray ray, double s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    double e0 = ray_dS(ray, s);
+    double e1 = S(ray.o + s*ray.d);
+    return (double2)(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -177,7 +181,7 @@ double refine(Ray ray, double a0, double b0, double fa0, double fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(double3 ro, double3 rd, double t0, double t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     double s = t0;
     double3 f = values_at(ray, t0);
     double s1 = t0;
@@ -204,6 +208,7 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
     }
     return (Hit){found, t, steps};
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in *t (t1 when there is none) and the march steps taken in *steps.

@@ -117,8 +117,8 @@ float2 SD(float3 p, float3 d) {
     return (float2)(t1*t3 + t4*t6 + t7*t8, dx*(3.0f*t3*t8 - t7*t9) + dy*(3.0f*t3*t6 - t4*t9) + dz*(-3.0f*t4*t7 + 3.0f*t6*t8));
 }
 
-// The ray a march runs on: o + s d.
-Ray ray_of(float3 ro, float3 rd) {
+// The ray a march runs on: o + s d (sm and hr are not used by the point form).
+Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     return (Ray){ro, rd};
 }
 
@@ -130,7 +130,8 @@ float3 values_at(Ray ray, float s) {
 
 // (F, F') at s, for the refinement.
 float2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float2 e0 = SD(ray.o + s*ray.d, ray.d);
+    return (float2)(e0.x, e0.y);
 }
 
 // The step length at s, from the sample f0 there.
@@ -179,7 +180,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(float3 ro, float3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     float s = t0;
     float3 f = values_at(ray, t0);
     float s1 = t0;
@@ -206,6 +207,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     }
     return (Hit){found, t, steps};
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in *t (t1 when there is none) and the march steps taken in *steps.

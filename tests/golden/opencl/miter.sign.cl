@@ -29,6 +29,13 @@ __constant int REFINE_STEPS = 10;
 typedef struct {
     float3 o;  // origin of the march, s = 0
     float3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
 } Ray;
 
 typedef struct {
@@ -64,47 +71,49 @@ float3 grad(float3 p) {
     return (float3)(8.0f*x*(t0 + x_2) + 8.0f*x_3, t1*y - 2.0f*y*(1.0f - t0) + 2.0f*y_3, t1*z + 2.0f*y_2*z);
 }
 
-// S, dS at the point p along the unit direction d
-float2 SD(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
+    float3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
-    float x_3 = x*x_2;
     float y_2 = y*y;
-    float y_3 = y*y_2;
     float z_2 = z*z;
+    float dx_2 = dx*dx;
+    float dy_2 = dy*dy;
+    float dz_2 = dz*dz;
     float t0 = y_2 + z_2;
     float t1 = t0 + x_2;
-    float t2 = 1.0f - t0;
-    float t3 = 8.0f*x_2;
-    return (float2)(4.0f*t1*x_2 - t2*y_2, dx*(8.0f*t1*x + 8.0f*x_3) + dy*(-2.0f*t2*y + t3*y + 2.0f*y_3) + dz*(t3*z + 2.0f*y_2*z));
-}
-
-// dS at the point p along the unit direction d
-float dS(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float x_3 = x*x_2;
-    float y_2 = y*y;
-    float y_3 = y*y_2;
-    float z_2 = z*z;
-    float t0 = 8.0f*x_2;
-    float t1 = y_2 + z_2;
-    return dx*(8.0f*x*(t1 + x_2) + 8.0f*x_3) + dy*(t0*y - 2.0f*y*(1.0f - t1) + 2.0f*y_3) + dz*(t0*z + 2.0f*y_2*z);
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(float3 ro, float3 rd) {
-    return (Ray){ro, rd};
+    float t2 = 4.0f*x_2;
+    float t3 = 1.0f - t0;
+    float t4 = 2.0f*dy*y;
+    float t5 = 2.0f*dz*z + t4;
+    float t6 = -t5;
+    float t7 = dx*x;
+    float t8 = 8.0f*t7;
+    float t9 = t5 + 2.0f*t7;
+    float t10 = 4.0f*dx_2;
+    float t11 = dy_2 + dz_2;
+    float t12 = dx_2 + t11;
+    float t13 = -t11;
+    float c0 = t1*t2 - t3*y_2;
+    float c1 = t1*t8 + t2*t9 - t3*t4 - t6*y_2;
+    float c2 = -dy_2*t3 + t1*t10 + t12*t2 - t13*y_2 - t4*t6 + t8*t9;
+    float c3 = -dy_2*t6 + t10*t9 + t12*t8 - t13*t4;
+    float c4 = -dy_2*t13 + t10*t12;
+    float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
+    return (Ray){ro, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
@@ -115,12 +124,14 @@ float3 values_at(Ray ray, float s) {
 
 // (F, F') at s, for the refinement.
 float2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return (float2)(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
 float step_size(Ray ray, float s, float3 f0) {
-    return (TAU1 >= fabs(f0.x) ? (TAU3 >= fabs(dS(ray.o + s*ray.d, ray.d)) ? 0.25f*STEP : 0.5f*STEP) : (TAU2 < fabs(f0.x) ? 2.0f*STEP : STEP));
+    return (TAU1 >= fabs(f0.x) ? (TAU3 >= fabs(ray_dS(ray, s)) ? 0.25f*STEP : 0.5f*STEP) : (TAU2 < fabs(f0.x) ? 2.0f*STEP : STEP));
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
@@ -162,7 +173,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(float3 ro, float3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     float s = t0;
     float3 f = values_at(ray, t0);
     float s1 = t0;
@@ -189,6 +200,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     }
     return (Hit){found, t, steps};
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in *t (t1 when there is none) and the march steps taken in *steps.

@@ -29,6 +29,11 @@ __constant int REFINE_STEPS = 10;
 typedef struct {
     float3 o;  // origin of the march, s = 0
     float3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
 } Ray;
 
 typedef struct {
@@ -56,51 +61,53 @@ float3 grad(float3 p) {
     return (float3)(2.0f*x, 2.0f*y, 2.0f*z);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-float3 SDH(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+float2 ray_DH(Ray ray, float s) {
+    float u = s - ray.sm;
+    return (float2)(ray.c1 + 2.0f*ray.c2*u, 2.0f*ray.c2);
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + 2.0f*ray.c2*u;
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
+    float3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    return (float3)(x_2 + y_2 + z_2 - 1.0f, 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z, 2.0f*dx_2 + 2.0f*dy_2 + 2.0f*dz_2);
-}
-
-// S, dS at the point p along the unit direction d
-float2 SD(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float y_2 = y*y;
-    float z_2 = z*z;
-    return (float2)(x_2 + y_2 + z_2 - 1.0f, 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z);
-}
-
-// The ray a march runs on: o + s d.
-Ray ray_of(float3 ro, float3 rd) {
-    return (Ray){ro, rd};
+    float c0 = x_2 + y_2 + z_2 - 1.0f;
+    float c1 = 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z;
+    float c2 = dx_2 + dy_2 + dz_2;
+    float size = hr*(hr*fabs(c2) + fabs(c1)) + fabs(c0);
+    return (Ray){ro, rd, sm, size, c0, c1, c2};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 float3 values_at(Ray ray, float s) {
-    float3 e0 = SDH(ray.o + s*ray.d, ray.d);
-    return (float3)(e0.x, e0.y, e0.z);
+    float2 e0 = ray_DH(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return (float3)(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 float2 fd(Ray ray, float s) {
-    return SD(ray.o + s*ray.d, ray.d);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return (float2)(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -149,7 +156,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 Hit trace(float3 ro, float3 rd, float t0, float t1) {
-    Ray ray = ray_of(ro, rd);
+    Ray ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     float s = t0;
     float3 f = values_at(ray, t0);
     float s1 = t0;
@@ -176,6 +183,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     }
     return (Hit){found, t, steps};
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in *t (t1 when there is none) and the march steps taken in *steps.

@@ -26,6 +26,13 @@ __constant int STEINER_REFINE_STEPS = 10;
 typedef struct {
     float3 o;  // origin of the march, s = 0
     float3 d;  // unit direction
+    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
+    float c0;  // coefficient of (s - sm)^0
+    float c1;  // coefficient of (s - sm)^1
+    float c2;  // coefficient of (s - sm)^2
+    float c3;  // coefficient of (s - sm)^3
+    float c4;  // coefficient of (s - sm)^4
 } steiner_Ray;
 
 typedef struct {
@@ -57,59 +64,69 @@ float3 steiner_grad(float3 p) {
     return (float3)(2.0f*x*y_2 - 2.0f*x*z_2 - y*z, t0*x_2 + t0*z_2 - x*z, -x*y - 2.0f*x_2*z + 2.0f*y_2*z);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-float3 steiner_SDH(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+float2 steiner_ray_DH(steiner_Ray ray, float s) {
+    float u = s - ray.sm;
+    return (float2)(ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u)), 2.0f*ray.c2 + u*(6.0f*ray.c3 + 12.0f*ray.c4*u));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+float steiner_ray_dS(steiner_Ray ray, float s) {
+    float u = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+steiner_Ray steiner_ray_of(float3 ro, float3 rd, float sm, float hr) {
+    float3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = y*z;
-    float t1 = 2.0f*z_2;
-    float t2 = x*z;
-    float t3 = 2.0f*x_2;
-    float t4 = x*y;
-    float t5 = 2.0f*dx;
-    return (float3)(-t0*x + x_2*y_2 - x_2*z_2 + y_2*z_2, dx*(-t0 - t1*x + 2.0f*x*y_2) + dy*(t1*y - t2 + t3*y) + dz*(-t3*z - t4 + 2.0f*y_2*z), dx_2*(-t1 + 2.0f*y_2) + 2.0f*dy*dz*(-x + 4.0f*y*z) + dy*t5*(4.0f*t4 - z) + dy_2*(t1 + t3) + dz*t5*(-4.0f*t2 - y) + dz_2*(-t3 + 2.0f*y_2));
-}
-
-// S, dS at the point p along the unit direction d
-float2 steiner_SD(float3 p, float3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float y_2 = y*y;
-    float z_2 = z*z;
-    float t0 = y*z;
-    float t1 = 2.0f*y;
-    return (float2)(-t0*x + x_2*y_2 - x_2*z_2 + y_2*z_2, dx*(-t0 + 2.0f*x*y_2 - 2.0f*x*z_2) + dy*(t1*x_2 + t1*z_2 - x*z) + dz*(-x*y - 2.0f*x_2*z + 2.0f*y_2*z));
-}
-
-// The ray a march runs on: o + s d.
-steiner_Ray steiner_ray_of(float3 ro, float3 rd) {
-    return (steiner_Ray){ro, rd};
+    float t0 = x*y;
+    float t1 = dx*x;
+    float t2 = 2.0f*y_2;
+    float t3 = 2.0f*z_2;
+    float t4 = 2.0f*x_2;
+    float t5 = dy*y;
+    float t6 = dz*z;
+    float t7 = dx*y;
+    float t8 = dy*x;
+    float t9 = -t7 - t8;
+    float t10 = dx*dy;
+    float t11 = 4.0f*t6;
+    float t12 = 2.0f*t1;
+    float t13 = 2.0f*dx_2;
+    float c0 = -t0*z + x_2*y_2 - x_2*z_2 + y_2*z_2;
+    float c1 = -dz*t0 + t1*t2 - t1*t3 + t2*t6 + t3*t5 + t4*t5 - t4*t6 + t9*z;
+    float c2 = dx_2*y_2 - dx_2*z_2 + dy_2*x_2 + dy_2*z_2 + dz*t9 - dz_2*x_2 + dz_2*y_2 - t1*t11 - t10*z + t11*t5 + 4.0f*t7*t8;
+    float c3 = dy_2*t12 + 2.0f*dy_2*t6 - dz*t10 - dz_2*t12 + 2.0f*dz_2*t5 + t13*t5 - t13*t6;
+    float c4 = dx_2*dy_2 - dx_2*dz_2 + dy_2*dz_2;
+    float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
+    return (steiner_Ray){ro, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 float3 steiner_values_at(steiner_Ray ray, float s) {
-    float3 e0 = steiner_SDH(ray.o + s*ray.d, ray.d);
-    return (float3)(e0.x, e0.y, e0.z);
+    float2 e0 = steiner_ray_DH(ray, s);
+    float e1 = steiner_S(ray.o + s*ray.d);
+    return (float3)(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 float2 steiner_fd(steiner_Ray ray, float s) {
-    return steiner_SD(ray.o + s*ray.d, ray.d);
+    float e0 = steiner_ray_dS(ray, s);
+    float e1 = steiner_S(ray.o + s*ray.d);
+    return (float2)(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -158,7 +175,7 @@ float steiner_refine(steiner_Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 steiner_Hit steiner_trace(float3 ro, float3 rd, float t0, float t1) {
-    steiner_Ray ray = steiner_ray_of(ro, rd);
+    steiner_Ray ray = steiner_ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     float s = t0;
     float3 f = steiner_values_at(ray, t0);
     float s1 = t0;
@@ -185,6 +202,7 @@ steiner_Hit steiner_trace(float3 ro, float3 rd, float t0, float t1) {
     }
     return (steiner_Hit){found, t, steps};
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1): whether it hit,
 // the root in *t (t1 when there is none) and the march steps taken in *steps.

@@ -38,6 +38,15 @@ const REFINE_STEPS: i32 = 10;
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0
     d: vec3<f32>,  // unit direction
+    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
+    c0: f32,  // coefficient of (s - sm)^0
+    c1: f32,  // coefficient of (s - sm)^1
+    c2: f32,  // coefficient of (s - sm)^2
+    c3: f32,  // coefficient of (s - sm)^3
+    c4: f32,  // coefficient of (s - sm)^4
+    c5: f32,  // coefficient of (s - sm)^5
+    c6: f32,  // coefficient of (s - sm)^6
 }
 
 struct Hit {
@@ -75,14 +84,28 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(-t0*x + 20.944271909999163f*t1*t2*x - t2*t4*x, -t0*y - 8.0f*t1*t2*y + 20.944271909999163f*t1*t3*y, -t0*z - t1*t4*z + 20.944271909999163f*t2*t3*z);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
+    let u: f32 = s - ray.sm;
+    return vec2<f32>(ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + u*(4.0f*ray.c4 + u*(5.0f*ray.c5 + 6.0f*ray.c6*u)))), 2.0f*ray.c2 + u*(6.0f*ray.c3 + u*(12.0f*ray.c4 + u*(20.0f*ray.c5 + 30.0f*ray.c6*u))));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+fn ray_dS(ray: Ray, s: f32) -> f32 {
+    let u: f32 = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + u*(4.0f*ray.c4 + u*(5.0f*ray.c5 + 6.0f*ray.c6*u))));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
+    let oc: vec3<f32> = ro + sm*rd;
+    let x: f32 = oc.x;
+    let y: f32 = oc.y;
+    let z: f32 = oc.z;
+    let dx: f32 = rd.x;
+    let dy: f32 = rd.y;
+    let dz: f32 = rd.z;
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
@@ -93,58 +116,50 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let t0_2: f32 = t0*t0;
     let t1: f32 = 2.6180339887498953f*y_2 - z_2;
     let t2: f32 = 2.6180339887498953f*x_2 - y_2;
-    let t3: f32 = -x_2 + 2.6180339887498953f*z_2;
+    let t3: f32 = -4.0f*x_2 + 10.472135954999581f*z_2;
     let t4: f32 = t2*t3;
-    let t5: f32 = 16.94427190999916f*t0;
-    let t6: f32 = 8.0f*t1;
-    let t7: f32 = t2*t6;
-    let t8: f32 = t3*t6;
-    let t9: f32 = 8.0f*t4;
-    let t10: f32 = 33.88854381999832f*x;
-    let t11: f32 = x*y;
-    let t12: f32 = 2.0f*dx;
-    let t13: f32 = y*z;
-    let t14: f32 = 16.94427190999916f*y_2;
-    let t15: f32 = 16.94427190999916f*z_2 - 16.94427190999916f;
-    let t16: f32 = 16.94427190999916f*x_2;
-    return vec3<f32>(-4.23606797749979f*t0_2 + 4.0f*t1*t4, dx*(20.944271909999163f*t1*t3*x - t5*x - t7*x) + dy*(20.944271909999163f*t2*t3*y - t5*y - t8*y) + dz*(20.944271909999163f*t1*t2*z - t5*z - t9*z), dx_2*(20.944271909999163f*t1*t3 - 83.77708763999665f*t1*x_2 - t14 - t15 - t7 - 50.83281572999748f*x_2) + 2.0f*dy*dz*(-41.888543819998326f*t1*t13 + 109.665631459995f*t13*t2 + 16.0f*t13*t3 - 33.88854381999832f*t13) + dy*t12*(16.0f*t1*t11 - t10*y - 41.888543819998326f*t11*t2 + 109.665631459995f*t11*t3) + dy_2*(-t15 - t16 + 20.944271909999163f*t2*t3 - 83.77708763999665f*t3*y_2 - t8 - 50.83281572999748f*y_2) + dz*t12*(109.665631459995f*t1*x*z - t10*z + 16.0f*t2*x*z - 41.888543819998326f*t3*x*z) + dz_2*(20.944271909999163f*t1*t2 - t14 - t16 - 83.77708763999665f*t2*z_2 - t9 - 50.83281572999748f*z_2 + 16.94427190999916f));
-}
-
-// S, dS at the point p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let y_2: f32 = y*y;
-    let z_2: f32 = z*z;
-    let t0: f32 = x_2 + y_2 + z_2 - 1.0f;
-    let t0_2: f32 = t0*t0;
-    let t1: f32 = -x_2 + 2.6180339887498953f*z_2;
-    let t2: f32 = 2.6180339887498953f*x_2 - y_2;
-    let t3: f32 = 2.6180339887498953f*y_2 - z_2;
-    let t4: f32 = t2*t3;
-    let t5: f32 = 16.94427190999916f*t0;
-    return vec2<f32>(-4.23606797749979f*t0_2 + 4.0f*t1*t4, dx*(20.944271909999163f*t1*t3*x - 8.0f*t4*x - t5*x) + dy*(20.944271909999163f*t1*t2*y - 8.0f*t1*t3*y - t5*y) + dz*(-8.0f*t1*t2*z + 20.944271909999163f*t2*t3*z - t5*z));
-}
-
-// The ray a march runs on: o + s d.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
-    return Ray(ro, rd);
+    let t5: f32 = dx*x;
+    let t6: f32 = dy*y;
+    let t7: f32 = 2.0f*t6;
+    let t8: f32 = 2.0f*dz*z;
+    let t9: f32 = 2.0f*t5 + t7 + t8;
+    let t9_2: f32 = t9*t9;
+    let t10: f32 = 8.47213595499958f*t0;
+    let t11: f32 = 5.236067977499791f*t6 - t8;
+    let t12: f32 = 5.236067977499791f*t5 - t7;
+    let t13: f32 = 20.944271909999163f*dz*z - 8.0f*t5;
+    let t14: f32 = t12*t3 + t13*t2;
+    let t15: f32 = dx_2 + dy_2 + dz_2;
+    let t15_2: f32 = t15*t15;
+    let t16: f32 = 2.6180339887498953f*dy_2 - dz_2;
+    let t17: f32 = -4.0f*dx_2 + 10.472135954999581f*dz_2;
+    let t18: f32 = 2.6180339887498953f*dx_2 - dy_2;
+    let t19: f32 = t12*t13 + t17*t2 + t18*t3;
+    let t20: f32 = t12*t17 + t13*t18;
+    let t21: f32 = t17*t18;
+    let c0: f32 = -4.23606797749979f*t0_2 + t1*t4;
+    let c1: f32 = t1*t14 - t10*t9 + t11*t4;
+    let c2: f32 = t1*t19 - t10*t15 + t11*t14 + t16*t4 - 4.23606797749979f*t9_2;
+    let c3: f32 = t1*t20 + t11*t19 + t14*t16 - 8.47213595499958f*t15*t9;
+    let c4: f32 = t1*t21 + t11*t20 - 4.23606797749979f*t15_2 + t16*t19;
+    let c5: f32 = t11*t21 + t16*t20;
+    let c6: f32 = t16*t21;
+    let size: f32 = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 fn values_at(ray: Ray, s: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
-    return vec3<f32>(e0.x, e0.y, e0.z);
+    let e0: vec2<f32> = ray_DH(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec3<f32>(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    return SD(ray.o + s*ray.d, ray.d);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec2<f32>(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -193,7 +208,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let ray: Ray = ray_of(ro, rd);
+    let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     var s: f32 = t0;
     var f: vec3<f32> = values_at(ray, t0);
     var s1: f32 = t0;
@@ -220,6 +235,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
 // Returns (hit, t, steps); t = t1 when there is no hit.

@@ -178,8 +178,8 @@ fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(-t2 - t5 - t8 + 0.6f, dx*(-t2*(4.0f - t10) + 8.0f*t5*x - t8*(-t10 - 3.2f)) + dy*(8.0f*t2*y - t5*(-t11 - 2.4f) - t8*(3.2f - t11)) + dz*(t2*t9 - t5*(4.0f - t9) + t8*t9));
 }
 
-// The ray a march runs on: o + s d.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
+// The ray a march runs on: o + s d (sm and hr are not used by the point form).
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     return Ray(ro, rd);
 }
 
@@ -191,7 +191,8 @@ fn values_at(ray: Ray, s: f32) -> vec3<f32> {
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    return SD(ray.o + s*ray.d, ray.d);
+    let e0: vec2<f32> = SD(ray.o + s*ray.d, ray.d);
+    return vec2<f32>(e0.x, e0.y);
 }
 
 // The step length at s, from the sample f0 there.
@@ -240,7 +241,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let ray: Ray = ray_of(ro, rd);
+    let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     var s: f32 = t0;
     var f: vec3<f32> = values_at(ray, t0);
     var s1: f32 = t0;
@@ -267,6 +268,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
 // Returns (hit, t, steps); t = t1 when there is no hit.

@@ -38,6 +38,12 @@ const REFINE_STEPS: i32 = 10;
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0
     d: vec3<f32>,  // unit direction
+    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
+    c0: f32,  // coefficient of (s - sm)^0
+    c1: f32,  // coefficient of (s - sm)^1
+    c2: f32,  // coefficient of (s - sm)^2
+    c3: f32,  // coefficient of (s - sm)^3
 }
 
 struct Hit {
@@ -78,14 +84,28 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(-t1 - t2 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z, -t1 - t3 + 54.0f*x*z - 18.0f*y + 243.0f*y_2, -t2 - t3 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
+    let u: f32 = s - ray.sm;
+    return vec2<f32>(ray.c1 + u*(2.0f*ray.c2 + 3.0f*ray.c3*u), 2.0f*ray.c2 + 6.0f*ray.c3*u);
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+fn ray_dS(ray: Ray, s: f32) -> f32 {
+    let u: f32 = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + 3.0f*ray.c3*u);
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
+    let oc: vec3<f32> = ro + sm*rd;
+    let x: f32 = oc.x;
+    let y: f32 = oc.y;
+    let z: f32 = oc.z;
+    let dx: f32 = rd.x;
+    let dy: f32 = rd.y;
+    let dz: f32 = rd.z;
     let x_2: f32 = x*x;
     let x_3: f32 = x*x_2;
     let y_2: f32 = y*y;
@@ -93,61 +113,46 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let z_2: f32 = z*z;
     let z_3: f32 = z*z_2;
     let dx_2: f32 = dx*dx;
+    let dx_3: f32 = dx*dx_2;
     let dy_2: f32 = dy*dy;
+    let dy_3: f32 = dy*dy_2;
     let dz_2: f32 = dz*dz;
-    let t0: f32 = 189.0f*y_2;
-    let t1: f32 = 189.0f*z_2;
-    let t2: f32 = 189.0f*x_2;
-    let t3: f32 = 378.0f*y;
-    let t4: f32 = t1 + t3*x - 126.0f*z + 9.0f;
-    let t5: f32 = 378.0f*z;
-    let t6: f32 = t0 + t5*x - 126.0f*y;
-    let t7: f32 = t2 + t3*z - 126.0f*x;
-    let t8: f32 = t5 + 18.0f;
-    let t9: f32 = 378.0f*x;
-    let t10: f32 = t3 + t9;
-    let t11: f32 = 2.0f*dx;
-    return vec3<f32>(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t6 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t7 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t6 - t7 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f), dx_2*(-t3 - t8 + 486.0f*x) + 2.0f*dy*dz*(-t3 - t5 + 54.0f*x + 126.0f) + dy*t11*(-t10 + 54.0f*z + 126.0f) + dy_2*(-t8 - t9 + 486.0f*y) + dz*t11*(-t5 - t9 + 54.0f*y + 126.0f) + dz_2*(-t10 + 486.0f*z - 18.0f));
-}
-
-// S, dS at the point p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let x_3: f32 = x*x_2;
-    let y_2: f32 = y*y;
-    let y_3: f32 = y*y_2;
-    let z_2: f32 = z*z;
-    let z_3: f32 = z*z_2;
-    let t0: f32 = 189.0f*y_2;
-    let t1: f32 = 189.0f*z_2;
-    let t2: f32 = 189.0f*x_2;
-    let t3: f32 = 378.0f*x;
-    let t4: f32 = t1 + t3*y - 126.0f*z + 9.0f;
-    let t5: f32 = t0 + t3*z - 126.0f*y;
-    let t6: f32 = t2 - 126.0f*x + 378.0f*y*z;
-    return vec2<f32>(-t0*x - t0*z - t1*x - t1*y - t2*y - t2*z + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f, dx*(-t4 - t5 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z) + dy*(-t4 - t6 + 54.0f*x*z - 18.0f*y + 243.0f*y_2) + dz*(-t5 - t6 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f));
-}
-
-// The ray a march runs on: o + s d.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
-    return Ray(ro, rd);
+    let dz_3: f32 = dz*dz_2;
+    let t0: f32 = 189.0f*x;
+    let t1: f32 = 189.0f*y;
+    let t2: f32 = 189.0f*z;
+    let t3: f32 = dx*x;
+    let t4: f32 = dy*y;
+    let t5: f32 = dz*z;
+    let t6: f32 = 378.0f*t3;
+    let t7: f32 = dy*x;
+    let t8: f32 = 378.0f*y;
+    let t9: f32 = 378.0f*t4;
+    let t10: f32 = 378.0f*t5;
+    let t11: f32 = 189.0f*dx;
+    let t12: f32 = 189.0f*dy;
+    let t13: f32 = 189.0f*dz;
+    let t14: f32 = 54.0f*dx*y + 54.0f*t7;
+    let c0: f32 = -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f;
+    let c1: f32 = 243.0f*dx*x_2 + 126.0f*dx*y + 126.0f*dx*z - 9.0f*dx + 126.0f*dy*x + 243.0f*dy*y_2 + 126.0f*dy*z - 9.0f*dy + 54.0f*dz*x*y + 126.0f*dz*x + 126.0f*dz*y + 243.0f*dz*z_2 - 9.0f*dz - t10*x - t11*y_2 - t11*z_2 - t12*x_2 - t12*z_2 - t13*x_2 - t13*y_2 + t14*z - 18.0f*t3 - 18.0f*t4 - t5*t8 - 18.0f*t5 - t6*y - t6*z - t7*t8 - t9*z;
+    let c2: f32 = 54.0f*dx*dy*z + 126.0f*dx*dy + 126.0f*dx*dz - dx*t10 - 378.0f*dx*t7 - dx*t9 - dx_2*t1 - dx_2*t2 + 243.0f*dx_2*x - 9.0f*dx_2 + 126.0f*dy*dz - dy*t10 - dy_2*t0 - dy_2*t2 + 243.0f*dy_2*y - 9.0f*dy_2 + dz*t14 - dz*t6 - dz*t9 - dz_2*t0 - dz_2*t1 + 243.0f*dz_2*z - 9.0f*dz_2;
+    let c3: f32 = 54.0f*dx*dy*dz - dx_2*t12 - dx_2*t13 + 81.0f*dx_3 - dy_2*t11 - dy_2*t13 + 81.0f*dy_3 - dz_2*t11 - dz_2*t12 + 81.0f*dz_3;
+    let size: f32 = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 fn values_at(ray: Ray, s: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
-    return vec3<f32>(e0.x, e0.y, e0.z);
+    let e0: vec2<f32> = ray_DH(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec3<f32>(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    return SD(ray.o + s*ray.d, ray.d);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec2<f32>(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -196,7 +201,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let ray: Ray = ray_of(ro, rd);
+    let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     var s: f32 = t0;
     var f: vec3<f32> = values_at(ray, t0);
     var s1: f32 = t0;
@@ -223,6 +228,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
 // Returns (hit, t, steps); t = t1 when there is no hit.

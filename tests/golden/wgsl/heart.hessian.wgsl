@@ -38,6 +38,15 @@ const REFINE_STEPS: i32 = 10;
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0
     d: vec3<f32>,  // unit direction
+    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
+    c0: f32,  // coefficient of (s - sm)^0
+    c1: f32,  // coefficient of (s - sm)^1
+    c2: f32,  // coefficient of (s - sm)^2
+    c3: f32,  // coefficient of (s - sm)^3
+    c4: f32,  // coefficient of (s - sm)^4
+    c5: f32,  // coefficient of (s - sm)^5
+    c6: f32,  // coefficient of (s - sm)^6
 }
 
 struct Hit {
@@ -75,14 +84,28 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(6.0f*t0_2*x - 2.0f*x*z_3, 13.5f*t0_2*y - 0.225f*y*z_3, 6.0f*t0_2*z - 3.0f*x_2*z_2 - 0.3375f*y_2*z_2);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
+    let u: f32 = s - ray.sm;
+    return vec2<f32>(ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + u*(4.0f*ray.c4 + u*(5.0f*ray.c5 + 6.0f*ray.c6*u)))), 2.0f*ray.c2 + u*(6.0f*ray.c3 + u*(12.0f*ray.c4 + u*(20.0f*ray.c5 + 30.0f*ray.c6*u))));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+fn ray_dS(ray: Ray, s: f32) -> f32 {
+    let u: f32 = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + u*(4.0f*ray.c4 + u*(5.0f*ray.c5 + 6.0f*ray.c6*u))));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
+    let oc: vec3<f32> = ro + sm*rd;
+    let x: f32 = oc.x;
+    let y: f32 = oc.y;
+    let z: f32 = oc.z;
+    let dx: f32 = rd.x;
+    let dy: f32 = rd.y;
+    let dz: f32 = rd.z;
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
@@ -90,47 +113,53 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let dx_2: f32 = dx*dx;
     let dy_2: f32 = dy*dy;
     let dz_2: f32 = dz*dz;
-    let t0: f32 = x_2 + 2.25f*y_2 + z_2 - 1.0f;
-    let t0_2: f32 = t0*t0;
-    let t0_3: f32 = t0*t0_2;
-    let t1: f32 = 2.0f*z_3;
-    let t2: f32 = 0.225f*z_3;
-    let t3: f32 = 2.0f*dz;
-    return vec3<f32>(t0_3 - x_2*z_3 - 0.1125f*y_2*z_3, dx*(6.0f*t0_2*x - t1*x) + dy*(13.5f*t0_2*y - t2*y) + dz*(6.0f*t0_2*z - 3.0f*x_2*z_2 - 0.3375f*y_2*z_2), 108.0f*dx*dy*t0*x*y + dx*t3*(24.0f*t0*x*z - 6.0f*x*z_2) + dx_2*(24.0f*t0*x_2 + 6.0f*t0_2 - t1) + dy*t3*(54.0f*t0*y*z - 0.675f*y*z_2) + dy_2*(121.5f*t0*y_2 + 13.5f*t0_2 - t2) + dz_2*(24.0f*t0*z_2 + 6.0f*t0_2 - 6.0f*x_2*z - 0.675f*y_2*z));
-}
-
-// S, dS at the point p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let y_2: f32 = y*y;
-    let z_2: f32 = z*z;
-    let z_3: f32 = z*z_2;
-    let t0: f32 = x_2 + 2.25f*y_2 + z_2 - 1.0f;
-    let t0_2: f32 = t0*t0;
-    let t0_3: f32 = t0*t0_2;
-    return vec2<f32>(t0_3 - x_2*z_3 - 0.1125f*y_2*z_3, dx*(6.0f*t0_2*x - 2.0f*x*z_3) + dy*(13.5f*t0_2*y - 0.225f*y*z_3) + dz*(6.0f*t0_2*z - 3.0f*x_2*z_2 - 0.3375f*y_2*z_2));
-}
-
-// The ray a march runs on: o + s d.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
-    return Ray(ro, rd);
+    let dz_3: f32 = dz*dz_2;
+    let t0: f32 = 0.1125f*z_3;
+    let t1: f32 = x_2 + 2.25f*y_2 + z_2 - 1.0f;
+    let t1_2: f32 = t1*t1;
+    let t1_3: f32 = t1*t1_2;
+    let t2: f32 = dx*x;
+    let t3: f32 = 2.0f*t2;
+    let t4: f32 = dy*y;
+    let t5: f32 = 0.225f*t4;
+    let t6: f32 = dz*z_2;
+    let t7: f32 = 3.0f*x_2;
+    let t8: f32 = 0.3375f*y_2;
+    let t9: f32 = 2.0f*dz*z + t3 + 4.5f*t4;
+    let t9_2: f32 = t9*t9;
+    let t10: f32 = 6.0f*t2;
+    let t11: f32 = 0.675f*t4;
+    let t12: f32 = dz_2*z;
+    let t13: f32 = dx_2 + 2.25f*dy_2 + dz_2;
+    let t13_2: f32 = t13*t13;
+    let t13_3: f32 = t13*t13_2;
+    let t14: f32 = 2.0f*t1*t13 + t9_2;
+    let t15: f32 = 0.1125f*dz_3;
+    let t16: f32 = 3.0f*dx_2;
+    let t17: f32 = 0.3375f*dy_2;
+    let c0: f32 = -t0*y_2 + t1_3 - x_2*z_3;
+    let c1: f32 = 3.0f*t1_2*t9 - t3*z_3 - t5*z_3 - t6*t7 - t6*t8;
+    let c2: f32 = -dx_2*z_3 - dy_2*t0 + t1*t14 + 2.0f*t1*t9_2 - t10*t6 - t11*t6 - t12*t7 - t12*t8 + t13*t1_2;
+    let c3: f32 = -dz_3*x_2 + 4.0f*t1*t13*t9 - t10*t12 - t11*t12 + t14*t9 - t15*y_2 - t16*t6 - t17*t6;
+    let c4: f32 = -dz_3*t3 - dz_3*t5 + t1*t13_2 - t12*t16 - t12*t17 + t13*t14 + 2.0f*t13*t9_2;
+    let c5: f32 = -dx_2*dz_3 - dy_2*t15 + 3.0f*t13_2*t9;
+    let c6: f32 = t13_3;
+    let size: f32 = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 fn values_at(ray: Ray, s: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
-    return vec3<f32>(e0.x, e0.y, e0.z);
+    let e0: vec2<f32> = ray_DH(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec3<f32>(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    return SD(ray.o + s*ray.d, ray.d);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec2<f32>(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -179,7 +208,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let ray: Ray = ray_of(ro, rd);
+    let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     var s: f32 = t0;
     var f: vec3<f32> = values_at(ray, t0);
     var s1: f32 = t0;
@@ -206,6 +235,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
 // Returns (hit, t, steps); t = t1 when there is no hit.

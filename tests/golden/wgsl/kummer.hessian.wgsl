@@ -38,6 +38,13 @@ const REFINE_STEPS: i32 = 10;
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0
     d: vec3<f32>,  // unit direction
+    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
+    c0: f32,  // coefficient of (s - sm)^0
+    c1: f32,  // coefficient of (s - sm)^1
+    c2: f32,  // coefficient of (s - sm)^2
+    c3: f32,  // coefficient of (s - sm)^3
+    c4: f32,  // coefficient of (s - sm)^4
 }
 
 struct Hit {
@@ -89,14 +96,28 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(t0*x - t1*t11 + t1*t9, t0*y + t1*t13 - t1*t14, t0*z + t11 - t13 - t14 + t9);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
+    let u: f32 = s - ray.sm;
+    return vec2<f32>(ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u)), 2.0f*ray.c2 + u*(6.0f*ray.c3 + 12.0f*ray.c4*u));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+fn ray_dS(ray: Ray, s: f32) -> f32 {
+    let u: f32 = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
+    let oc: vec3<f32> = ro + sm*rd;
+    let x: f32 = oc.x;
+    let y: f32 = oc.y;
+    let z: f32 = oc.z;
+    let dx: f32 = rd.x;
+    let dy: f32 = rd.y;
+    let dz: f32 = rd.z;
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
@@ -106,86 +127,52 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let t0: f32 = x_2 + y_2 + z_2 - 1.3f;
     let t0_2: f32 = t0*t0;
     let t1: f32 = 1.4142135623730951f;
-    let t2: f32 = t1*y;
-    let t3: f32 = z + 1.0f;
-    let t4: f32 = t2 + t3;
-    let t5: f32 = -t2 + t3;
-    let t6: f32 = t4*t5;
-    let t7: f32 = t1*x;
-    let t8: f32 = t7 - z + 1.0f;
-    let t9: f32 = -t7 - z + 1.0f;
-    let t10: f32 = t8*t9;
-    let t11: f32 = 1.7058823529411766f*t10;
-    let t12: f32 = 4.0f*t0;
-    let t13: f32 = 1.7058823529411766f*t6;
-    let t14: f32 = t13*t8;
-    let t15: f32 = t13*t9;
-    let t16: f32 = t11*t4;
-    let t17: f32 = t11*t5;
-    let t18: f32 = 4.0f*y_2;
-    let t19: f32 = 4.0f*z_2 - 5.2f;
-    let t20: f32 = 4.0f*x_2;
-    let t21: f32 = 8.0f*x;
-    let t22: f32 = 3.4117647058823533f*t4;
-    let t23: f32 = t22*t8;
-    let t24: f32 = 3.4117647058823533f*t5;
-    let t25: f32 = t24*t9;
-    let t26: f32 = t22*t9 + t24*t8;
-    let t27: f32 = 2.0f*dx;
-    let t28: f32 = 1.7058823529411766f*t1;
-    let t29: f32 = t28*t9;
-    let t30: f32 = t29*t5;
-    let t31: f32 = t28*t8;
-    let t32: f32 = t31*t4;
-    let t33: f32 = -t29*t4 + t31*t5;
-    return vec3<f32>(t0_2 - t11*t6, dx*(t1*t14 - t1*t15 + t12*x) + dy*(t1*t16 - t1*t17 + t12*y) + dz*(t12*z + t14 + t15 - t16 - t17), dx_2*(t18 + t19 + 6.8235294117647065f*t6 + 12.0f*x_2) + 2.0f*dy*dz*(t30 - t32 + t33 + 8.0f*y*z) + dy*t27*(t21*y - t23 - t25 + t26) + dy_2*(6.8235294117647065f*t10 + t19 + t20 + 12.0f*y_2) + dz*t27*(t21*z - t30 + t32 + t33) + dz_2*(-3.4117647058823533f*t10 + t18 + t20 + t23 + t25 + t26 - 3.4117647058823533f*t6 + 12.0f*z_2 - 5.2f));
-}
-
-// S, dS at the point p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let y_2: f32 = y*y;
-    let z_2: f32 = z*z;
-    let t0: f32 = x_2 + y_2 + z_2 - 1.3f;
-    let t0_2: f32 = t0*t0;
-    let t1: f32 = 1.4142135623730951f;
-    let t2: f32 = t1*y;
-    let t3: f32 = z + 1.0f;
-    let t4: f32 = -t2 + t3;
-    let t5: f32 = t2 + t3;
-    let t6: f32 = t1*x;
-    let t7: f32 = t6 - z + 1.0f;
-    let t8: f32 = -t6 - z + 1.0f;
-    let t9: f32 = 1.7058823529411766f*t7*t8;
-    let t10: f32 = t5*t9;
-    let t11: f32 = 4.0f*t0;
-    let t12: f32 = 1.7058823529411766f*t4*t5;
-    let t13: f32 = t12*t7;
-    let t14: f32 = t12*t8;
-    let t15: f32 = t4*t9;
-    return vec2<f32>(t0_2 - t10*t4, dx*(t1*t13 - t1*t14 + t11*x) + dy*(t1*t10 - t1*t15 + t11*y) + dz*(-t10 + t11*z + t13 + t14 - t15));
-}
-
-// The ray a march runs on: o + s d.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
-    return Ray(ro, rd);
+    let t2: f32 = t1*x;
+    let t3: f32 = -t2 - z + 1.0f;
+    let t4: f32 = t2 - z + 1.0f;
+    let t5: f32 = t1*y;
+    let t6: f32 = -1.7058823529411766f*t5 - 1.7058823529411766f*z - 1.7058823529411766f;
+    let t7: f32 = -t5 + z + 1.0f;
+    let t8: f32 = t6*t7;
+    let t9: f32 = t4*t8;
+    let t10: f32 = 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z;
+    let t10_2: f32 = t10*t10;
+    let t11: f32 = 2.0f*t0;
+    let t12: f32 = dx*t1;
+    let t13: f32 = -dz - t12;
+    let t14: f32 = -dz;
+    let t15: f32 = t12 + t14;
+    let t16: f32 = dy*t1;
+    let t17: f32 = -1.7058823529411766f*dz - 1.7058823529411766f*t16;
+    let t18: f32 = -t14 - t16;
+    let t19: f32 = t17*t7 + t18*t6;
+    let t20: f32 = t15*t8 + t19*t4;
+    let t21: f32 = dx_2 + dy_2 + dz_2;
+    let t21_2: f32 = t21*t21;
+    let t22: f32 = t17*t18;
+    let t23: f32 = t15*t19 + t22*t4;
+    let t24: f32 = t15*t22;
+    let c0: f32 = t0_2 + t3*t9;
+    let c1: f32 = t10*t11 + t13*t9 + t20*t3;
+    let c2: f32 = t10_2 + t11*t21 + t13*t20 + t23*t3;
+    let c3: f32 = 2.0f*t10*t21 + t13*t23 + t24*t3;
+    let c4: f32 = t13*t24 + t21_2;
+    let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 fn values_at(ray: Ray, s: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
-    return vec3<f32>(e0.x, e0.y, e0.z);
+    let e0: vec2<f32> = ray_DH(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec3<f32>(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    return SD(ray.o + s*ray.d, ray.d);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec2<f32>(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -234,7 +221,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let ray: Ray = ray_of(ro, rd);
+    let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     var s: f32 = t0;
     var f: vec3<f32> = values_at(ray, t0);
     var s1: f32 = t0;
@@ -261,6 +248,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
 // Returns (hit, t, steps); t = t1 when there is no hit.

@@ -38,6 +38,13 @@ const REFINE_STEPS: i32 = 10;
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0
     d: vec3<f32>,  // unit direction
+    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
+    c0: f32,  // coefficient of (s - sm)^0
+    c1: f32,  // coefficient of (s - sm)^1
+    c2: f32,  // coefficient of (s - sm)^2
+    c3: f32,  // coefficient of (s - sm)^3
+    c4: f32,  // coefficient of (s - sm)^4
 }
 
 struct Hit {
@@ -73,67 +80,69 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(8.0f*x*(t0 + x_2) + 8.0f*x_3, t1*y - 2.0f*y*(1.0f - t0) + 2.0f*y_3, t1*z + 2.0f*y_2*z);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
+    let u: f32 = s - ray.sm;
+    return vec2<f32>(ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u)), 2.0f*ray.c2 + u*(6.0f*ray.c3 + 12.0f*ray.c4*u));
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+fn ray_dS(ray: Ray, s: f32) -> f32 {
+    let u: f32 = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
+    let oc: vec3<f32> = ro + sm*rd;
+    let x: f32 = oc.x;
+    let y: f32 = oc.y;
+    let z: f32 = oc.z;
+    let dx: f32 = rd.x;
+    let dy: f32 = rd.y;
+    let dz: f32 = rd.z;
     let x_2: f32 = x*x;
-    let x_3: f32 = x*x_2;
     let y_2: f32 = y*y;
-    let y_3: f32 = y*y_2;
     let z_2: f32 = z*z;
     let dx_2: f32 = dx*dx;
     let dy_2: f32 = dy*dy;
     let dz_2: f32 = dz*dz;
     let t0: f32 = y_2 + z_2;
     let t1: f32 = t0 + x_2;
-    let t2: f32 = 1.0f - t0;
-    let t3: f32 = 8.0f*x_2;
-    let t4: f32 = 2.0f*y_2;
-    let t5: f32 = dy*y;
-    let t6: f32 = 32.0f*dx*x;
-    let t7: f32 = dz*z;
-    return vec3<f32>(4.0f*t1*x_2 - t2*y_2, dx*(8.0f*t1*x + 8.0f*x_3) + dy*(-2.0f*t2*y + t3*y + 2.0f*y_3) + dz*(t3*z + t4*z), dx_2*(48.0f*x_2 + 8.0f*y_2 + 8.0f*z_2) + dy_2*(t3 + 12.0f*y_2 + 2.0f*z_2 - 2.0f) + dz_2*(t3 + t4) + t5*t6 + 8.0f*t5*t7 + t6*t7);
-}
-
-// S, dS at the point p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let x_3: f32 = x*x_2;
-    let y_2: f32 = y*y;
-    let y_3: f32 = y*y_2;
-    let z_2: f32 = z*z;
-    let t0: f32 = y_2 + z_2;
-    let t1: f32 = t0 + x_2;
-    let t2: f32 = 1.0f - t0;
-    let t3: f32 = 8.0f*x_2;
-    return vec2<f32>(4.0f*t1*x_2 - t2*y_2, dx*(8.0f*t1*x + 8.0f*x_3) + dy*(-2.0f*t2*y + t3*y + 2.0f*y_3) + dz*(t3*z + 2.0f*y_2*z));
-}
-
-// The ray a march runs on: o + s d.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
-    return Ray(ro, rd);
+    let t2: f32 = 4.0f*x_2;
+    let t3: f32 = 1.0f - t0;
+    let t4: f32 = 2.0f*dy*y;
+    let t5: f32 = 2.0f*dz*z + t4;
+    let t6: f32 = -t5;
+    let t7: f32 = dx*x;
+    let t8: f32 = 8.0f*t7;
+    let t9: f32 = t5 + 2.0f*t7;
+    let t10: f32 = 4.0f*dx_2;
+    let t11: f32 = dy_2 + dz_2;
+    let t12: f32 = dx_2 + t11;
+    let t13: f32 = -t11;
+    let c0: f32 = t1*t2 - t3*y_2;
+    let c1: f32 = t1*t8 + t2*t9 - t3*t4 - t6*y_2;
+    let c2: f32 = -dy_2*t3 + t1*t10 + t12*t2 - t13*y_2 - t4*t6 + t8*t9;
+    let c3: f32 = -dy_2*t6 + t10*t9 + t12*t8 - t13*t4;
+    let c4: f32 = -dy_2*t13 + t10*t12;
+    let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 fn values_at(ray: Ray, s: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
-    return vec3<f32>(e0.x, e0.y, e0.z);
+    let e0: vec2<f32> = ray_DH(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec3<f32>(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    return SD(ray.o + s*ray.d, ray.d);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec2<f32>(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -182,7 +191,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let ray: Ray = ray_of(ro, rd);
+    let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     var s: f32 = t0;
     var f: vec3<f32> = values_at(ray, t0);
     var s1: f32 = t0;
@@ -209,6 +218,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
 // Returns (hit, t, steps); t = t1 when there is no hit.

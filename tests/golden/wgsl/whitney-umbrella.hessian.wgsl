@@ -38,6 +38,12 @@ const REFINE_STEPS: i32 = 10;
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0
     d: vec3<f32>,  // unit direction
+    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
+    c0: f32,  // coefficient of (s - sm)^0
+    c1: f32,  // coefficient of (s - sm)^1
+    c2: f32,  // coefficient of (s - sm)^2
+    c3: f32,  // coefficient of (s - sm)^3
 }
 
 struct Hit {
@@ -65,50 +71,53 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(2.0f*x, -2.0f*y*z, -y_2);
 }
 
-// S, dS, d2S at the point p along the unit direction d
-fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
+// dS, d2S at ray parameter s: Horner on the ray polynomial
+fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
+    let u: f32 = s - ray.sm;
+    return vec2<f32>(ray.c1 + u*(2.0f*ray.c2 + 3.0f*ray.c3*u), 2.0f*ray.c2 + 6.0f*ray.c3*u);
+}
+
+// dS at ray parameter s: Horner on the ray polynomial
+fn ray_dS(ray: Ray, s: f32) -> f32 {
+    let u: f32 = s - ray.sm;
+    return ray.c1 + u*(2.0f*ray.c2 + 3.0f*ray.c3*u);
+}
+
+// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
+// expanded about s = sm, the middle of the march interval, hr its half length.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
+    let oc: vec3<f32> = ro + sm*rd;
+    let x: f32 = oc.x;
+    let y: f32 = oc.y;
+    let z: f32 = oc.z;
+    let dx: f32 = rd.x;
+    let dy: f32 = rd.y;
+    let dz: f32 = rd.z;
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let dx_2: f32 = dx*dx;
     let dy_2: f32 = dy*dy;
-    let t0: f32 = 2.0f*z;
-    let t1: f32 = dy*y;
-    return vec3<f32>(x_2 - y_2*z, 2.0f*dx*x - dz*y_2 - t0*t1, 2.0f*dx_2 - dy_2*t0 - 4.0f*dz*t1);
-}
-
-// S, dS at the point p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let y_2: f32 = y*y;
-    return vec2<f32>(x_2 - y_2*z, 2.0f*dx*x - 2.0f*dy*y*z - dz*y_2);
-}
-
-// The ray a march runs on: o + s d.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>) -> Ray {
-    return Ray(ro, rd);
+    let t0: f32 = 2.0f*dy*y;
+    let c0: f32 = x_2 - y_2*z;
+    let c1: f32 = 2.0f*dx*x - dz*y_2 - t0*z;
+    let c2: f32 = dx_2 - dy_2*z - dz*t0;
+    let c3: f32 = -dy_2*dz;
+    let size: f32 = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
+    return Ray(ro, rd, sm, size, c0, c1, c2, c3);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
 fn values_at(ray: Ray, s: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
-    return vec3<f32>(e0.x, e0.y, e0.z);
+    let e0: vec2<f32> = ray_DH(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec3<f32>(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    return SD(ray.o + s*ray.d, ray.d);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec2<f32>(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
@@ -157,7 +166,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) Start the ray near the surface
 // (e.g. at its clip-sphere entry) to keep float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
-    let ray: Ray = ray_of(ro, rd);
+    let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     var s: f32 = t0;
     var f: vec3<f32> = values_at(ray, t0);
     var s1: f32 = t0;
@@ -184,6 +193,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     return Hit(found, t, steps);
 }
+
 
 // Adaptive Marching Points over [t0, t1] of the ray ro + t rd (|rd| = 1).
 // Returns (hit, t, steps); t = t1 when there is no hit.
