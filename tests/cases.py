@@ -34,7 +34,8 @@ def opencl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [(ex, m, "float", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
     cases += [(ex, "hessian", "float", "library") for ex in PAPER]
     cases += [("cross-cap", "hessian", "double", "program")]
-    cases += [("cross-cap", "exact", "float", "library"), ("cross-cap", "exact", "double", "program")]
+    cases += [("cross-cap", "exact", "float", "library"),
+              ("cross-cap", "exact", "double", "program")]
     return cases
 
 
@@ -55,7 +56,8 @@ def wgsl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [(ex, m, "paper", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
     cases += [("cross-cap", m, "consistent", "program") for m in ("hessian", "hessian-approx")]
     cases += [(ex, "hessian", "paper", "library") for ex in PAPER]
-    cases += [("cross-cap", "taylor", "paper", "library"), ("cross-cap", "exact", "paper", "library")]
+    cases += [("cross-cap", "taylor", "paper", "library"),
+              ("cross-cap", "exact", "paper", "library")]
     return cases
 
 
