@@ -143,6 +143,7 @@ class Code:
 
     lets: tuple[tuple[str, str, str], ...]
     values: tuple[str, ...]
+    what: str = ""  # a comment for the reader of the shader
 
 
 @dataclass(frozen=True)
@@ -310,7 +311,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     rule = method.root_rule(constants.taylor2)
     ends = {**ends0, **ends1}
     root = Code(tuple(("real", s.name, show(v.xreplace(ends))) for s, v in rule.lets),
-                (show(rule.value.xreplace(ends)),))
+                (show(rule.value.xreplace(ends)),), rule.what)
 
     used = set().union(*(e.free_symbols for e in (*method.sample, method.step, rule.value,
                                                     *(v for _, v in rule.lets))))

@@ -90,6 +90,7 @@ class Rule:
 
     value: sympy.Basic
     lets: tuple[tuple[sympy.Symbol, sympy.Basic], ...] = ()
+    what: str = ""  # what it is, printed as a comment in the shader
 
 
 # --- the pieces the paper's methods are made of --------------------------------------
@@ -111,13 +112,17 @@ U0, U1, M0, M1 = sympy.symbols("u0 u1 m0 m1", real=True)
 
 # Eq. 3: first-order Taylor extension towards the midpoint from both ends.
 TAYLOR = Rule(interval_test(F0, Q, R, F1),
-              ((Q, F0 + D0 * H / 2), (R, F1 - D1 * H / 2)))
+              ((Q, F0 + D0 * H / 2), (R, F1 - D1 * H / 2)),
+              "Eq. 3: first-order Taylor extension towards the midpoint from both ends")
 # Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
 EQ4_PAPER = Rule(interval_test(F0, Q, R, F1),
-                 ((Q, F0 + D0 * H / 2 + X0 * H**2 / 2), (R, F1 - D1 * H / 2 + X0 * H**2 / 2)))
+                 ((Q, F0 + D0 * H / 2 + X0 * H**2 / 2), (R, F1 - D1 * H / 2 + X0 * H**2 / 2)),
+                 "Eq. 4 as printed: F''(t0) in both q and r, with h^2/2")
 # Eq. 4, consistent reading: second-order Taylor to the midpoint, (h/2)^2/2 = h^2/8.
 _CONSISTENT_LETS = ((Q, F0 + D0 * H / 2 + X0 * H**2 / 8), (R, F1 - D1 * H / 2 + X1 * H**2 / 8))
-EQ4_CONSISTENT = Rule(interval_test(F0, Q, R, F1), _CONSISTENT_LETS)
+EQ4_CONSISTENT = Rule(interval_test(F0, Q, R, F1), _CONSISTENT_LETS,
+                      "Eq. 4, consistent reading: second-order Taylor to the midpoint, "
+                      "(h/2)^2/2 = h^2/8, F''(t1) in r")
 # implc's extension: also the extremum of each end's quadratic model inside the step,
 # F(t0 + u) ~ F0 + F0' u + F0'' u^2/2 at u = -F0'/F0'' (and alike from t1), so a dip of F
 # below zero between the ends (two close crossings) is seen too.
@@ -129,6 +134,8 @@ EQ4_EXTREMUM = Rule(
         (M0, Piecewise((F0 + D0 * U0 / 2, (U0 > 0) & (U0 < H)), (F0, True))),
         (M1, Piecewise((F1 - D1 * U1 / 2, (U1 > 0) & (U1 < H)), (F1, True))),
     ),
+    "Eq. 4 consistent, plus implc's extension: the extremum of each end's quadratic model "
+    "inside the step",
 )
 EQ4 = {"paper": EQ4_PAPER, "consistent": EQ4_CONSISTENT, "extremum": EQ4_EXTREMUM}
 
@@ -167,7 +174,8 @@ METHODS: dict[str, Method] = {
     for m in (
         Method("sign", "Eq. 2 steps; root where F changes sign between step ends",
                # F' is needed only near the surface: the step rule evaluates it there
-               (F(S), sympy.S.Zero, sympy.S.Zero), eq2(F0, DF(S)), Rule(F0 * F1 < 0)),
+               (F(S), sympy.S.Zero, sympy.S.Zero), eq2(F0, DF(S)),
+               Rule(F0 * F1 < 0, what="the sign test: F changes sign between the ends")),
         Method("taylor", "Eq. 2 steps; first-order Taylor interval test (Eq. 3)",
                (F(S), DF(S), sympy.S.Zero), eq2(F0, D0), TAYLOR,
                paper_column="Taylor Test"),

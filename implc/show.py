@@ -54,6 +54,15 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
     if degree is None:
         return ["", "ray-poly form: not available (S is not a polynomial)"]
     coefficients = coefficient_program(surface.expr)
+    if method.solves:
+        return [
+            "",
+            "exact (root isolation of the ray polynomial; no marching):",
+            f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
+            f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
+            f"  derivatives P1..P{degree - 1} of F by Horner (P_k: {'k multiply-adds'}); "
+            "F by Horner where its sign is certain, else S at the point",
+        ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
     horner = {"dS": 2 * (degree - 1) + 1, "d2S": 2 * max(degree - 2, 0) + 1}

@@ -40,10 +40,14 @@ def test_list_shows_examples_with_degree():
 
 
 def test_show_reports_op_counts():
-    proc = implc("show", "cross-cap")
+    proc = implc("show", "cross-cap", "-m", "hessian")
     assert proc.returncode == 0, proc.stderr
     assert "degree:    4" in proc.stdout
     assert "SDH" in proc.stdout and "->" in proc.stdout
+    assert "ray-poly form" in proc.stdout and "coefficients c0..c4" in proc.stdout
+    proc = implc("show", "cross-cap")  # the default method for a quartic: exact
+    assert proc.returncode == 0, proc.stderr
+    assert "exact (root isolation" in proc.stdout
 
 
 def test_compile_to_stdout_and_file(tmp_path):

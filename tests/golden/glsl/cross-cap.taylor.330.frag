@@ -133,6 +133,7 @@ float step_size(Ray ray, float s, vec3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 3: first-order Taylor extension towards the midpoint from both ends.
 bool root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h;
     float r = f1.x - 0.5*f1.y*h;

@@ -10,6 +10,9 @@
 //   bool  cross_cap_intersect(vec3 ro, vec3 rd, float t0, float t1, out float t)
 //   bool  cross_cap_march(vec3 ro, vec3 rd, float t0, float t1, out float t, out int steps)
 //   vec3  cross_cap_shade(vec3 g, vec3 rd)
+//   cross_cap_Ray cross_cap_ray_of(vec3 ro, vec3 rd, float sm, float hr)
+//       the ray record march/intersect use: o, d, the ray polynomial's
+//       coefficients c0..cn of F(s) = S(o + s d) = sum c_k (s - sm)^k and size = sum |c_k| hr^k.
 // rd must be unit length; t is measured along rd from ro.
 
 // Method constants (implc compile options).
@@ -128,6 +131,7 @@ float cross_cap_step_size(cross_cap_Ray ray, float s, vec3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 3: first-order Taylor extension towards the midpoint from both ends.
 bool cross_cap_root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h;
     float r = f1.x - 0.5*f1.y*h;

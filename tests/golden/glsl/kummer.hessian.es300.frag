@@ -174,6 +174,7 @@ float step_size(Ray ray, float s, vec3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
 bool root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     float r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;

@@ -10,6 +10,9 @@
 //   bool  steiner_intersect(vec3 ro, vec3 rd, float t0, float t1, out float t)
 //   bool  steiner_march(vec3 ro, vec3 rd, float t0, float t1, out float t, out int steps)
 //   vec3  steiner_shade(vec3 g, vec3 rd)
+//   steiner_Ray steiner_ray_of(vec3 ro, vec3 rd, float sm, float hr)
+//       the ray record march/intersect use: o, d, the ray polynomial's
+//       coefficients c0..cn of F(s) = S(o + s d) = sum c_k (s - sm)^k and size = sum |c_k| hr^k.
 // rd must be unit length; t is measured along rd from ro.
 
 // Method constants (implc compile options).
@@ -132,6 +135,7 @@ float steiner_step_size(steiner_Ray ray, float s, vec3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
 bool steiner_root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     float r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;

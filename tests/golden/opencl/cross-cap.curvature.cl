@@ -143,6 +143,7 @@ float step_size(Ray ray, float s, float3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 3: first-order Taylor extension towards the midpoint from both ends.
 bool root_in(float3 f0, float3 f1, float h) {
     float q = f0.x + 0.5f*f0.y*h;
     float r = f1.x - 0.5f*f1.y*h;

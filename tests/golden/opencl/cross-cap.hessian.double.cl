@@ -141,6 +141,7 @@ double step_size(Ray ray, double s, double3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
 bool root_in(double3 f0, double3 f1, double h) {
     double q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     double r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;

@@ -12,6 +12,9 @@
 //   bool   cross_cap_intersect(float3 ro, float3 rd, float t0, float t1, float* t)
 //   bool   cross_cap_march(float3 ro, float3 rd, float t0, float t1, float* t, int* steps)
 //   float3 cross_cap_shade(float3 g, float3 rd)
+//   cross_cap_Ray cross_cap_ray_of(float3 ro, float3 rd, float sm, float hr)
+//       the ray record march/intersect use: o, d, the ray polynomial's
+//       coefficients c0..cn of F(s) = S(o + s d) = sum c_k (s - sm)^k and size = sum |c_k| hr^k.
 // rd must be unit length; t is measured along rd from ro; t and steps point to private
 // memory.
 
@@ -137,6 +140,7 @@ float cross_cap_step_size(cross_cap_Ray ray, float s, float3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
 bool cross_cap_root_in(float3 f0, float3 f1, float h) {
     float q = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
     float r = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;

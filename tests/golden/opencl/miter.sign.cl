@@ -135,6 +135,7 @@ float step_size(Ray ray, float s, float3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// the sign test: F changes sign between the ends.
 bool root_in(float3 f0, float3 f1, float h) {
     return f0.x*f1.x < 0.0f;
 }

@@ -142,6 +142,7 @@ fn step_size(ray: Ray, s: f32, f0: vec3<f32>) -> f32 {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// the sign test: F changes sign between the ends.
 fn root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
     return f0.x*f1.x < 0.0f;
 }

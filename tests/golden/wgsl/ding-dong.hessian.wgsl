@@ -131,6 +131,7 @@ fn step_size(ray: Ray, s: f32, f0: vec3<f32>) -> f32 {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
 fn root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
     let q: f32 = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
     let r: f32 = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;

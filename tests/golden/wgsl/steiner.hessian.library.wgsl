@@ -10,6 +10,9 @@
 //   fn steiner_intersect(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> steiner_Hit
 //   fn steiner_march(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> steiner_Hit
 //   fn steiner_shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32>
+//   fn steiner_ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> steiner_Ray
+//       the ray record march/intersect use: o, d, the ray polynomial's
+//       coefficients c0..cn of F(s) = S(o + s d) = sum c_k (s - sm)^k and size = sum |c_k| hr^k.
 // struct steiner_Hit { hit: bool, t: f32, steps: i32 }: WGSL has no `out` parameters.
 // rd must be unit length; t is measured along rd from ro.
 
@@ -133,6 +136,7 @@ fn steiner_step_size(ray: steiner_Ray, s: f32, f0: vec3<f32>) -> f32 {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
+// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
 fn steiner_root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
     let q: f32 = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
     let r: f32 = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
