@@ -7,6 +7,7 @@ opens its own page (a fresh context, so no state leaks between tests) and closes
 from __future__ import annotations
 
 import io
+import os
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -61,11 +62,19 @@ def file_url(path: Path, query: str = "") -> str:
     return Path(path).resolve().as_uri() + (f"?{query}" if query else "")
 
 
-def screenshot(locator) -> np.ndarray:
-    """An element as the user sees it: float RGB in [0, 1], shape (H, W, 3), row 0 on top."""
+def screenshot(locator, name: str = "") -> np.ndarray:
+    """An element as the user sees it: float RGB in [0, 1], shape (H, W, 3), row 0 on top.
+
+    With IMPLC_SCREENSHOTS=DIR set, a named screenshot is also saved there as NAME.png
+    (to look at what a test saw)."""
     from PIL import Image
 
-    image = Image.open(io.BytesIO(locator.screenshot())).convert("RGB")
+    png = locator.screenshot()
+    keep = os.environ.get("IMPLC_SCREENSHOTS")
+    if keep and name:
+        Path(keep).mkdir(parents=True, exist_ok=True)
+        (Path(keep) / f"{name}.png").write_bytes(png)
+    image = Image.open(io.BytesIO(png)).convert("RGB")
     return np.asarray(image, dtype=np.float64) / 255.0
 
 
