@@ -24,6 +24,7 @@ def test_wheel_finds_templates_and_examples(tmp_path):
         check=True, capture_output=True, timeout=300,
     )
     assert (site / "implc" / "templates" / "glsl" / "marcher.glsl.j2").is_file()
+    assert (site / "implc" / "templates" / "view" / "viewer.html.j2").is_file()
     # Run from an unrelated directory with only the installed copy on the path.
     env = {**os.environ, "PYTHONPATH": str(site)}
     proc = subprocess.run(
