@@ -234,6 +234,9 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--precision", choices=list(precisions), help="; ".join(
         f"{t.name}: {' or '.join(t.precisions)} (default {t.precisions[0]})"
         for t in TARGETS.values() if len(t.precisions) > 1))
+    p.add_argument("--params", choices=("constant", "uniform"), default="constant",
+                   help="constant (default): parameter values baked into the shader; "
+                        "uniform: parameters are uniforms the host sets at run time")
     _method_args(p)
 
 
@@ -337,7 +340,7 @@ def cmd_compile(args) -> int:
 
     surface = _surface(args)
     text = emit(surface, args.target, args.method, _constants(args), args.flavor, args.emit,
-                args.prefix, precision=args.precision)
+                args.prefix, precision=args.precision, params=args.params)
     if args.validate:
         from .validate import validate_text
 
@@ -376,7 +379,7 @@ def cmd_render(args) -> int:
     surface = _surface(args)
     start = time.perf_counter()
     paths = render_surface(surface, backend, args.method, _constants(args), width, height,
-                           args.output)
+                           args.output, params=args.params)
     elapsed = time.perf_counter() - start
     for path in paths:
         print(f"wrote {path}")

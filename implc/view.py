@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .emit import emit, render_template
+from .emit import emit, param_uniforms, render_template
 from .methods import Constants, get_method
 from .surface import Surface
 
@@ -24,7 +24,8 @@ SLIDER_TICKS = 1000
 @dataclass(frozen=True)
 class Slider:
     name: str  # the parameter's name in the equation
-    uniform: str  # its GLSL uniform / WGSL field name
+    uniform: str  # its GLSL uniform (and WGSL field) name
+    wgsl_offset: int  # byte offset of its field in the WGSL program's Uniforms
     value: float
     low: float
     high: float
@@ -34,17 +35,16 @@ class Slider:
         return (self.high - self.low) / SLIDER_TICKS
 
 
-def param_uniforms(surface: Surface) -> dict[str, str]:  # TODO(part 1): from emit
-    return {name: f"u_param_{name}" for name in sorted(surface.params)}
-
-
 def sliders(surface: Surface) -> list[Slider]:
-    """One slider per parameter, centred on its value (sorted by name, like the uniforms)."""
+    """One slider per uniform parameter, centred on its value (sorted by name, like the
+    uniforms; a parameter only inside constant exponents has none, see
+    `Surface.uniform_params`)."""
     result = []
-    for name, uniform in param_uniforms(surface).items():
-        value = float(surface.params[name])
-        half = max(abs(value), SLIDER_MIN_HALF_WIDTH)
-        result.append(Slider(name, uniform, value, value - half, value + half))
+    wgsl = {u.name: u for u in param_uniforms(surface, "wgsl")}
+    for u in param_uniforms(surface, "glsl"):
+        half = max(abs(u.value), SLIDER_MIN_HALF_WIDTH)
+        result.append(Slider(u.name, u.uniform, wgsl[u.name].offset, u.value, u.value - half,
+                             u.value + half))
     return result
 
 
@@ -53,11 +53,11 @@ def viewer_page(surface: Surface, method: str = "hessian",
     """The HTML text of the viewer for `surface` (deterministic, byte for byte)."""
     meth = get_method(method)
     constants = constants or meth.defaults
-    glsl = emit(surface, "glsl", method, constants, flavor="es300", )
-    wgsl = emit(surface, "wgsl", method, constants, ) if webgpu else ""
+    glsl = emit(surface, "glsl", method, constants, flavor="es300", params="uniform")
+    wgsl = emit(surface, "wgsl", method, constants, params="uniform") if webgpu else ""
     view = surface.view
     data = {
-        "surface": {"name": surface.name, "equation": surface.equation,
+        "surface": {"name": surface.name, "equation": surface.symbolic_equation,
                     "origin": surface.origin},
         "method": {"name": meth.name, "summary": meth.summary, "step": constants.step,
                    "taylor2": constants.taylor2,
@@ -66,8 +66,8 @@ def viewer_page(surface: Surface, method: str = "hessian",
                  "fov_y": view.fov_y_deg, "clip_center": list(view.clip_center),
                  "clip_radius": view.clip_radius},
         "params": [
-            {"name": s.name, "uniform": s.uniform, "value": s.value, "low": s.low,
-             "high": s.high, "step": s.step}
+            {"name": s.name, "uniform": s.uniform, "wgsl_index": s.wgsl_offset // 4,
+             "value": s.value, "low": s.low, "high": s.high, "step": s.step}
             for s in sliders(surface)
         ],
         "glsl": {
