@@ -57,6 +57,7 @@ class WgpuRunner(TimedRunner):
         dev = wgpu_device()
         self.device, self.width, self.height = dev, width, height
         self.view, self.params = view, tuple(params)
+        self.values = {p.name: p.value for p in self.params}  # set_params keeps the rest
         aux_bytes = width * height * 16
         if aux_bytes > dev.limits["max-storage-buffer-binding-size"]:
             raise ToolError(f"wgpu: a {width}x{height} aux buffer ({aux_bytes} bytes) exceeds "
@@ -100,13 +101,12 @@ class WgpuRunner(TimedRunner):
     def set_params(self, values: Mapping[str, float]) -> None:
         """New parameter values for the next frames (a `--params uniform` program): the
         uniform buffer is rewritten, nothing is compiled again."""
-        current = {p.name: p.value for p in self.params}
-        unknown = set(values) - set(current)
+        unknown = set(values) - set(self.values)
         if unknown:
             raise KeyError(f"not a uniform parameter: {', '.join(sorted(unknown))}")
-        current.update(values)
-        self.device.queue.write_buffer(
-            self.uniforms, 0, _uniforms(self.view, self.width, self.height, self.params, current))
+        self.values.update({k: float(v) for k, v in values.items()})
+        self.device.queue.write_buffer(self.uniforms, 0, _uniforms(
+            self.view, self.width, self.height, self.params, self.values))
 
     def draw(self) -> None:
         """Record and submit one frame: the compute pass and the copies out of it."""
