@@ -33,7 +33,7 @@ from browser_support import (
 )
 from conftest import _require
 
-from implc.emit import emit, render_template
+from implc.emit import emit, param_uniforms, render_template
 from implc.methods import METHODS
 from implc.render.run import render
 from implc.render.wgpu_runner import _uniforms
@@ -183,7 +183,8 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
     surface = load_surface("torus")
     view = surface.view
     prefix = "torus_"
-    library = emit(surface, "glsl", "hessian", hessian(), emit="library", prefix=prefix)
+    library = emit(surface, "glsl", "hessian", hessian(), emit="library", prefix=prefix,
+                   params="uniform")
     data = {
         "width": THREE_SIZE, "height": THREE_SIZE,
         "view": {"eye": view.eye, "target": view.target, "up": view.up, "fov_y": view.fov_y_deg,
@@ -192,7 +193,9 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
         "vertex": render_template("three/surface.vert.glsl.j2"),
         "fragment": render_template("three/surface.frag.glsl.j2", library=library,
                                     prefix=prefix),
-        "params": {}, "box": BOX,
+        "params": {u.uniform: u.value
+                   for u in param_uniforms(surface, "glsl", "library", prefix)},
+        "box": BOX,
     }
     page_path = tmp_path / "three.html"
     page_path.write_text(render_template("browser/three.html.j2", data=data,
@@ -205,6 +208,10 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
         for name, flags in {"both": [True, True], "surface": [True, False]}.items():
             assert page.evaluate("([s, b]) => implcThree.show(s, b)", flags) == ""
             shots[name] = screenshot(page.locator("#canvas"), f"three-{name}")
+        # the library's parameter uniforms, through three's material.uniforms
+        page.evaluate("implcThree.setParam('torus_u_param_r', 0.5)")
+        assert page.evaluate("implcThree.show(true, false)") == ""
+        shots["r=0.5"] = screenshot(page.locator("#canvas"), "three-r0.5")
         assert log.problems() == []
     assert revision == three_module().parent.parent.joinpath("package.json").read_text() \
         .split('"version": "')[1].split(".")[1]
@@ -229,6 +236,12 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
           f"box vs the depth-composited reference {score_both:.5f}; box in front on "
           f"{mesh_front.sum()} px, surface in front on {surface_front.sum()} px, "
           f"{right / overlap.sum():.4f} right")
+    moved = render(load_surface("torus", params=["r=0.5"]), "reference", "hessian", hessian(),
+                   THREE_SIZE, THREE_SIZE)
+    score_moved = ssim(shots["r=0.5"], to_8bit(np.where(
+        moved.hit[..., None], moved.color, np.asarray(SHADING.background))))
+    print(f"three: torus_u_param_r = 0.5 vs the reference of r=0.5: SSIM {score_moved:.5f}")
+    assert score_moved >= SSIM_SAME and ssim(shots["r=0.5"], shots["surface"]) < 0.95
     assert mesh_front.sum() > 100 and surface_front.sum() > 100, "the scene lost its overlap"
     assert right >= 0.99 * overlap.sum()
     assert score_surface >= SSIM_SAME and score_both >= SSIM_SAME
