@@ -226,7 +226,8 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
     both = shots["both"]
     red = np.all(np.abs(both - np.asarray(BOX["color"])) < 0.02, axis=-1)
     overlap = np.isfinite(surf_t) & np.isfinite(mesh_t)
-    overlap &= np.abs(np.where(overlap, surf_t - mesh_t, 0.0)) > DEPTH_TIE
+    gap = np.abs(np.where(overlap, surf_t, 0.0) - np.where(overlap, mesh_t, 0.0))
+    overlap &= gap > DEPTH_TIE
     mesh_front, surface_front = overlap & (mesh_t < surf_t), overlap & (surf_t < mesh_t)
     right = np.count_nonzero(red[mesh_front]) + np.count_nonzero(~red[surface_front])
     score_surface = ssim(shots["surface"], to_8bit(np.where(
