@@ -6,13 +6,19 @@ STAMP := $(VENV)/.implc-installed
 OUT := out
 # Debian packages: glslangValidator, headless EGL/Mesa for moderngl (llvmpipe),
 # Vulkan loader + lavapipe for wgpu, Debian's PoCL (its LLVM 15 builds for CPUs the PoCL wheel
-# cannot name, e.g. AMD Zen 5: see implc/render/cl_runner.py device()).
+# cannot name, e.g. AMD Zen 5: see implc/render/cl_runner.py device()), Chromium for the
+# browser tests (WebGL2 and WebGPU on SwiftShader, driven by Playwright for Python from the
+# test extras).
 APT_PACKAGES := glslang-tools libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
-  pocl-opencl-icd
+  pocl-opencl-icd chromium
+# three.js for the browser tests, pinned in tests/browser/package-lock.json (npm ci).
+NPM_DIR := tests/browser
+NPM_STAMP := $(NPM_DIR)/node_modules/.implc-installed
+VIEW_SURFACE := torus
 
-.PHONY: setup demo test golden lint bench bench-baseline forms clean system-packages fuzz corpus
+.PHONY: setup demo view test golden lint bench bench-baseline forms clean system-packages fuzz corpus
 
-setup: system-packages $(STAMP)
+setup: system-packages $(STAMP) $(NPM_STAMP)
 
 system-packages:
 	@missing=""; for p in $(APT_PACKAGES); do \
@@ -30,11 +36,24 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install -q -e '.[test]'
 	touch $(STAMP)
 
+$(NPM_STAMP): $(NPM_DIR)/package.json $(NPM_DIR)/package-lock.json
+	@command -v npm >/dev/null || { echo "installing Debian packages: nodejs npm"; \
+	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; }
+	cd $(NPM_DIR) && npm ci --no-audit --no-fund --loglevel=error
+	touch $@
+
 demo: setup
 	@mkdir -p $(OUT)
 	$(PY) -m implc compile cross-cap -t glsl -m exact --validate -o $(OUT)/cross-cap-exact.frag
 	$(PY) -m implc render cross-cap -m exact --size 512 -o $(OUT)/cross-cap-exact.png
 	@echo "demo: look at $(CURDIR)/$(OUT)/cross-cap-exact.png (shader: $(OUT)/cross-cap-exact.frag)"
+
+# The live viewer (after `make demo`): one self-contained HTML page; open it in a browser.
+view: setup
+	@mkdir -p $(OUT)
+	$(PY) -m implc view $(VIEW_SURFACE) -o $(OUT)/$(VIEW_SURFACE).html
+	@echo "view: open file://$(CURDIR)/$(OUT)/$(VIEW_SURFACE).html in a browser (drag to turn, sliders move the parameters)"
 
 test: setup
 	$(PY) -m ruff check implc tests
@@ -88,4 +107,4 @@ corpus: setup
 	$(PY) -m implc corpus -j 2 -o docs/CORPUS.md
 
 clean:
-	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache
+	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules

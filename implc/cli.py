@@ -32,6 +32,7 @@ examples:
   implc compile cross-cap --emit library --prefix cc_ -o cc.glsl
   implc validate cross-cap.frag
   implc render cross-cap -m hessian --size 512 -o cross-cap.png
+  implc view torus -o torus.html
   implc compare cc-hessian.exr cc-reference.exr
   implc bench cross-cap miter steiner --size 512 -o results/
 
@@ -141,6 +142,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="out.png (for people) or out.exr (R G B A Z steps); out.json beside it")
     p.set_defaults(run=cmd_render)
 
+    p = sub.add_parser("view", help="write a self-contained HTML page that shows a surface live",
+                       description="One HTML file, no network: the es300 program in WebGL2 "
+                                   "(and the WGSL program on WebGPU where the browser has "
+                                   "it), orbit/zoom/pan, a slider per parameter. Its first "
+                                   "frame is the surface's [view] camera, like `implc render`.")
+    _surface_args(p)
+    _method_args(p)
+    p.add_argument("--no-webgpu", action="store_true",
+                   help="leave the WGSL program out of the page (WebGL2 only)")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.html",
+                   help="the page to write")
+    p.set_defaults(run=cmd_view)
+
     p = sub.add_parser("compare", help="metrics of one EXR render against another",
                        description="SSIM, false/missed hits, wrong-root pixels and steps of "
                                    "render A against render B (typically the reference).")
@@ -219,9 +233,6 @@ def _limit_args(p: argparse.ArgumentParser) -> None:
 def _shader_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-t", "--target", choices=list(TARGETS), default="glsl",
                    help="shader language (default: glsl)")
-    p.add_argument("-m", "--method", choices=list(METHODS), default=None,
-                   help="root-finding method (default: exact for polynomial surfaces up to "
-                        f"degree {EXACT_MAX_DEGREE}, else hessian); see README \"The methods\"")
     p.add_argument("--flavor", help="; ".join(
         f"{t.name}: {', '.join(t.flavors)} (default {t.default_flavor})"
         for t in TARGETS.values() if len(t.flavors) > 1))
@@ -229,6 +240,16 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--precision", choices=list(precisions), help="; ".join(
         f"{t.name}: {' or '.join(t.precisions)} (default {t.precisions[0]})"
         for t in TARGETS.values() if len(t.precisions) > 1))
+    p.add_argument("--params", choices=("constant", "uniform"), default="constant",
+                   help="constant (default): parameter values baked into the shader; "
+                        "uniform: parameters are uniforms the host sets at run time")
+    _method_args(p)
+
+
+def _method_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("-m", "--method", choices=list(METHODS), default=None,
+                   help="root-finding method (default: exact for polynomial surfaces up to "
+                        f"degree {EXACT_MAX_DEGREE}, else hessian); see README \"The methods\"")
     d = Constants()
     c = p.add_argument_group("method constants (defaults: the paper's Table 1)")
     c.add_argument("--step", type=float, help="base step b (default 0.01; hessian 0.002)")
@@ -343,7 +364,7 @@ def cmd_compile(args) -> int:
     surface = _surface(args)
     _resolve_method(args, surface)
     text = emit(surface, args.target, args.method, _constants(args), args.flavor, args.emit,
-                args.prefix, precision=args.precision)
+                args.prefix, precision=args.precision, params=args.params)
     if args.validate:
         from .validate import validate_text
 
@@ -383,13 +404,25 @@ def cmd_render(args) -> int:
     _resolve_method(args, surface)
     start = time.perf_counter()
     paths = render_surface(surface, backend, args.method, _constants(args), width, height,
-                           args.output)
+                           args.output, params=args.params)
     elapsed = time.perf_counter() - start
     for path in paths:
         print(f"wrote {path}")
     what = backend if backend == "reference" else f"{backend}/{args.method}"
     print(f"rendered {width}x{height} with {what} in {elapsed:.2f} s",
           file=sys.stderr)
+    return EXIT_OK
+
+
+def cmd_view(args) -> int:
+    from .view import viewer_page
+
+    surface = _surface(args)
+    _resolve_method(args, surface)
+    page = viewer_page(surface, args.method, _constants(args), webgpu=not args.no_webgpu)
+    write_atomic(args.output, page)
+    print(f"wrote {args.output}")
+    print(f"open file://{args.output.resolve()} in a browser", file=sys.stderr)
     return EXIT_OK
 
 

@@ -9,6 +9,7 @@ strict: a name a template uses but emit does not give is an error, not an empty 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import lru_cache
 
 import jinja2
@@ -19,12 +20,53 @@ from .errors import InputError
 from .marcher import build_programs, choose_form, function_name, lower, point_sets
 from .methods import Constants, Method, get_method
 from .optimize import Program
+from .parse import param_symbol
 from .resources import data_dir
 from .scene import SHADING, View, light_directions
 from .surface import Surface
 from .targets import get_target
 
 EMITS = ("program", "library")
+PARAM_MODES = ("constant", "uniform")
+PARAM_UNIFORM_PREFIX = "u_param_"  # parameter R is the uniform u_param_R (README)
+WGSL_PARAM_OFFSET = 76  # byte offset of the first parameter field in the WGSL Uniforms
+
+
+@dataclass(frozen=True)
+class ParamUniform:
+    """How one parameter reaches a `--params uniform` shader (README "Parameters as
+    uniforms"): `uniform` is the name the host sets (a GLSL uniform, a WGSL struct field),
+    `ref` how the shader's code reads it."""
+
+    name: str  # the parameter's name in the equation
+    uniform: str
+    ref: str
+    value: float  # the surface's value (the default a host starts from)
+    offset: int | None = None  # WGSL program: byte offset in struct Uniforms
+
+
+def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program",
+                   prefix: str = "") -> list[ParamUniform]:
+    """The parameters of `surface` as uniforms of a `--params uniform` shader, sorted by
+    name (parameters only inside constant exponents stay constants, see
+    `Surface.uniform_params`)."""
+    result = []
+    for i, name in enumerate(surface.uniform_params()):
+        uniform = PARAM_UNIFORM_PREFIX + name
+        if "__" in uniform:
+            raise InputError(f"parameter '{name}' cannot be a shader uniform: names with "
+                             "'__' are reserved in GLSL (rename it or use --params constant)")
+        value = float(surface.params[name])
+        if target == "wgsl" and emit == "program":
+            result.append(ParamUniform(name, uniform, f"u.{uniform}", value,
+                                       WGSL_PARAM_OFFSET + 4 * i))
+        elif target == "wgsl":
+            result.append(ParamUniform(name, uniform, f"{prefix}params.{uniform}", value))
+        elif emit == "library":
+            result.append(ParamUniform(name, prefix + uniform, prefix + uniform, value))
+        else:
+            result.append(ParamUniform(name, uniform, uniform, value))
+    return result
 PREFIX_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 
 
@@ -67,8 +109,12 @@ def emit(
     prefix: str = "",
     precision: str | None = None,
     evaluation: str | None = None,
+    params: str = "constant",
 ) -> str:
-    """The complete shader text for `surface` (deterministic, byte for byte)."""
+    """The complete shader text for `surface` (deterministic, byte for byte).
+
+    `params`: "constant" bakes the parameters' values into the expressions; "uniform"
+    keeps them as uniforms the host sets at run time (`param_uniforms`)."""
     tgt = get_target(target)
     meth = get_method(method)
     constants = constants or meth.defaults
@@ -83,14 +129,31 @@ def emit(
     precision = precision or "float"
     if precision not in tgt.precisions:
         raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
+    if params not in PARAM_MODES:
+        raise InputError(f"unknown --params '{params}'; choose from {', '.join(PARAM_MODES)}")
+    uniforms = param_uniforms(surface, target, emit, prefix) if params == "uniform" else []
+    if uniforms and tgt.flavors[flavor].get("shadertoy"):
+        raise InputError("the shadertoy flavour has no uniforms of its own: use "
+                         "--params constant (the default) with --flavor shadertoy")
+    if uniforms and target == "opencl":
+        raise InputError("--params uniform is not available for opencl yet (README "
+                         "\"Parameters as uniforms\"); use --params constant")
     printer = tgt.printer(precision) if len(tgt.precisions) > 1 else tgt.printer()
+    expr, equation = surface.expr, surface.equation
+    if uniforms:  # the parameters as symbols named as the shader reads them
+        expr = surface.symbolic_expr.xreplace(
+            {param_symbol(u.name): sympy.Symbol(u.ref, real=True) for u in uniforms})
+        equation = surface.symbolic_equation
+    # the same form as with --params constant
     form = choose_form(surface.expr, evaluation or constants.evaluation)
-    marcher = lower(meth, constants, surface.expr, form, printer, prefix,
-                    current_max_derived())
+    marcher = lower(meth, constants, expr, form, printer, prefix, current_max_derived())
     label = meth.name + (f" (Eq. 4: {constants.taylor2})" if meth.reads_taylor2 else "")
     literals = {"zero": 0.0, "half": 0.5, "one": 1.0, "four": 4.0}
     context = {
-        "surface": {"name": surface.name, "equation": surface.equation},
+        "surface": {"name": surface.name, "equation": equation},
+        "params": [{"name": u.name, "uniform": u.uniform, "offset": u.offset,
+                    "value": printer.float_literal(u.value)} for u in uniforms],
+        "params_struct_size": -(-(WGSL_PARAM_OFFSET + 4 * len(uniforms)) // 16) * 16,
         "method": meth.name,
         "method_label": label,
         "form": form,

@@ -11,6 +11,7 @@ Three passes, all deterministic:
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -44,7 +45,8 @@ def optimize(outputs: Sequence[sympy.Expr], inputs: Sequence[sympy.Symbol]) -> P
 
 
 def _power_symbol(base: sympy.Symbol, n: int) -> sympy.Symbol:
-    return sympy.Symbol(f"{base.name}_{n}", real=True)
+    # a uniform's name may be a field access (WGSL `u.u_param_R`): its powers are locals
+    return sympy.Symbol(f"{re.sub(r'[^A-Za-z0-9_]', '_', base.name)}_{n}", real=True)
 
 
 def _name_powers(assignments, outputs):
@@ -113,9 +115,14 @@ def _renumber(assignments, outputs, powers):
 
 
 def _insert_power_chains(assignments, powers, inputs):
-    """Define each needed b_n right after b: b_2 = b*b, b_3 = b*b_2, b_4 = b_2*b_2."""
+    """Define each needed b_n right after b: b_2 = b*b, b_3 = b*b_2, b_4 = b_2*b_2.
+
+    Powers of a symbol that is neither an input nor a temporary (a parameter uniform,
+    `--params uniform`) are defined first, like the inputs' (sorted by name)."""
     ordered = []
-    for b in inputs:
+    defined = set(inputs) | {sym for sym, _ in assignments}
+    free = sorted((b for b in powers if b not in defined), key=lambda b: b.name)
+    for b in (*inputs, *free):
         ordered.extend(_power_chain(b, powers.get(b, set())))
     for sym, value in assignments:
         ordered.append((sym, value))

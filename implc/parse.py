@@ -66,7 +66,8 @@ from implc.errors import InputError, LimitError, Source
 from implc.functions import CONSTANTS, USER_FUNCTIONS
 from implc.symbols import X, Y, Z
 
-__all__ = ["Limits", "check_param_name", "parse_equation", "parse_number"]
+__all__ = ["Limits", "check_param_name", "param_symbol", "parse_equation",
+           "parse_equation_with_params", "parse_number"]
 
 
 @dataclass(frozen=True)
@@ -201,6 +202,36 @@ def parse_equation(
     `params` maps parameter names to their (rational) values; names are checked with
     `check_param_name`.
     """
+    return _parse(source, params, limits, keep_params=False)[0]
+
+
+def parse_equation_with_params(
+    source: Source,
+    params: Mapping[str, sympy.Expr],
+    limits: Limits = Limits(),  # noqa: B008 - frozen, so a shared default is safe
+) -> tuple[sympy.Expr, sympy.Expr]:
+    """`parse_equation`'s expression, and the same equation with every parameter kept as
+    a real symbol (`param_symbol(name)`) instead of its value, for `--params uniform`.
+
+    Every check runs on the substituted expression (with the parameters' values); the
+    symbolic one is then built from the same tree: a sub-expression without parameters
+    is the substituted build's own node, so both fold constants alike. One exception: a
+    parameter inside a constant exponent (`x^n`, `r^(1/k)`) keeps its value there (its
+    value decides what the power means: an integer power, a real odd root, or pow), so a
+    parameter that only appears in constant exponents is not free in the symbolic
+    expression. In an exponent that depends on x, y, z (`e^(-a x^2)`) it stays a symbol.
+    """
+    return _parse(source, params, limits, keep_params=True)
+
+
+def param_symbol(name: str) -> sympy.Symbol:
+    """The symbol of parameter `name` in a symbolic (`--params uniform`) expression."""
+    return sympy.Symbol(name, real=True)
+
+
+def _parse(
+    source: Source, params: Mapping[str, sympy.Expr] | None, limits: Limits, keep_params: bool
+) -> tuple[sympy.Expr, sympy.Expr | None]:
     text = source.text
     if len(text) > limits.max_chars:
         raise LimitError(
@@ -217,7 +248,11 @@ def parse_equation(
         tokens = _tokenize(text, values)
         root = _Parser(source, tokens, values, limits).parse()
         info = _Analyzer(source, values, limits).analyze(root)
-        return _Builder(source, values, info, limits).build(root)
+        builder = _Builder(source, values, info, limits)
+        expr = builder.build(root)
+        if not keep_params:
+            return expr, None
+        return expr, _build_symbolic(root, builder.built, info)
     except RecursionError:
         raise LimitError(
             f"too complex: nesting is too deep to parse with the limit of {limits.max_depth} "
@@ -300,6 +335,66 @@ def check_param_name(name: str, source: Source | None = None) -> None:
         raise InputError(
             f"parameter name '{name}' shadows the constant {constant}", source, 0, length
         )
+
+
+def _build_symbolic(
+    root: _Node, numeric: Mapping[_Node, sympy.Expr], info: Mapping[_Node, _Info]
+) -> sympy.Expr:
+    """The tree rebuilt with parameters as symbols (see `parse_equation_with_params`).
+
+    Nodes without a parameter below them are taken from the checked numeric build;
+    the others are rebuilt the way `_Builder` builds them, without the value checks
+    (they ran on the values already)."""
+    built: dict[_Node, sympy.Expr] = {}
+    symbolic: set[_Node] = set()
+    for node in _postorder(root):
+        if (isinstance(node, _Named) and node.is_param) or any(
+                c in symbolic for c in _children(node)):
+            symbolic.add(node)
+        if node not in symbolic:
+            built[node] = numeric[node]
+        elif isinstance(node, _Named):
+            built[node] = param_symbol(node.name)
+        elif isinstance(node, _Neg):
+            built[node] = -built[node.operand]
+        elif isinstance(node, _Sum):
+            built[node] = sympy.Add(*(-built[t] if neg else built[t]
+                                      for t, neg in zip(node.terms, node.negative, strict=True)))
+        elif isinstance(node, _Product):
+            built[node] = sympy.Mul(*(sympy.Pow(built[f], -1) if divide else built[f]
+                                      for f, divide in zip(node.factors, node.divide,
+                                                           strict=True)))
+        elif isinstance(node, _Power):
+            power = info[node.exponent].value
+            exponent = built[node.exponent] if power is None else numeric[node.exponent]
+            built[node] = _symbolic_power(built[node.base], exponent, power)
+        elif isinstance(node, _Call):
+            function = USER_FUNCTIONS[node.name]
+            args = [built[a] for a in node.args]
+            if function.sympy_name in _UNEVALUATED:
+                expr = function.build(*args, evaluate=False)
+            else:
+                expr = function.build(*args)
+            if expr.has(sympy.cot):
+                expr = expr.replace(sympy.cot, lambda u: 1 / sympy.tan(u))
+            built[node] = expr
+        else:  # pragma: no cover - numbers and variables hold no parameter
+            raise AssertionError(f"unexpected node {node!r}")
+    return built[root]
+
+
+def _symbolic_power(base: sympy.Expr, exponent: sympy.Expr, power: Fraction | None) -> sympy.Expr:
+    """`_Builder.make_power`'s result when base or exponent holds parameters; a constant
+    exponent (`power` is its exact value) comes from the numeric build."""
+    if power is None:
+        return sympy.Pow(base, exponent)
+    if power.denominator == 1:
+        return sympy.Pow(base, sympy.Integer(power.numerator))
+    rational = sympy.Rational(power.numerator, power.denominator)
+    if power.denominator % 2 == 0:
+        return sympy.Pow(base, rational)
+    magnitude = sympy.Pow(sympy.Abs(base), rational)
+    return sympy.sign(base) * magnitude if power.numerator % 2 else magnitude
 
 
 # --------------------------------------------------------------------------- helpers
@@ -1184,6 +1279,7 @@ class _Builder:
 
     def build(self, root: _Node) -> sympy.Expr:
         built: dict[_Node, sympy.Expr] = {}
+        self.built = built  # every node's expression (the symbolic build reuses them)
         order = _postorder(root)
         for node in order:
             built[node] = self.make(node, built)

@@ -28,7 +28,7 @@ from pathlib import Path
 import sympy
 
 from .errors import InputError, Source
-from .parse import Limits, check_param_name, parse_equation, parse_number
+from .parse import Limits, check_param_name, parse_equation_with_params, parse_number
 from .resources import data_dir
 from .scene import View
 from .textform import to_text
@@ -48,11 +48,29 @@ class Surface:
     params: dict[str, sympy.Rational] = field(default_factory=dict)
     view: View = field(default_factory=View)
     origin: str = "<equation>"  # file path, example name or "<equation>"
+    # S with the parameters as symbols (parse.param_symbol), for `--params uniform`;
+    # None when the surface has no parameters (then it is `expr`)
+    symbolic: sympy.Expr | None = None
 
     @property
     def equation(self) -> str:
         """The equation printed from the tree, in implc's own input language."""
         return to_text(self.expr)
+
+    @property
+    def symbolic_expr(self) -> sympy.Expr:
+        return self.expr if self.symbolic is None else self.symbolic
+
+    @property
+    def symbolic_equation(self) -> str:
+        """The equation with its parameters by name (what `--params uniform` compiles)."""
+        return to_text(self.symbolic_expr)
+
+    def uniform_params(self) -> list[str]:
+        """The parameters that stay free with `--params uniform`, sorted by name: every
+        parameter, less those that only appear in constant exponents (`x^n`)."""
+        free = {s.name for s in self.symbolic_expr.free_symbols}
+        return sorted(name for name in self.params if name in free)
 
     def params_json(self) -> dict[str, float]:
         return {k: float(v) for k, v in sorted(self.params.items())}
@@ -81,7 +99,8 @@ def load_surface(
     if equation is not None:
         source = Source("<equation>", equation)
         values = dict(overrides)
-        return Surface("equation", parse_equation(source, values, limits), values, View())
+        expr, symbolic = _parse(source, values, limits)
+        return Surface("equation", expr, values, View(), symbolic=symbolic)
     path = Path(spec)
     if not path.suffix and not path.exists():
         examples = example_paths()
@@ -143,11 +162,17 @@ def _load_toml(
         values[key] = parse_number(repr(value), src)
     values.update(overrides)
     source = Source(name, equation, *_string_position(text, "equation", equation))
-    expr = parse_equation(source, values, limits)
+    expr, symbolic = _parse(source, values, limits)
     title = data.get("name", path.stem)
     if not isinstance(title, str):
         raise InputError(f"{name}: `name` must be a string")
-    return Surface(title, expr, values, _view(name, data.get("view", {})), origin)
+    return Surface(title, expr, values, _view(name, data.get("view", {})), origin, symbolic)
+
+
+def _parse(source: Source, values: Mapping[str, sympy.Rational], limits: Limits):
+    """(expr with the values substituted, expr with parameter symbols or None)."""
+    expr, symbolic = parse_equation_with_params(source, values, limits)
+    return expr, (symbolic if values else None)
 
 
 def _view(name: str, table) -> View:

@@ -41,3 +41,57 @@ def require_gl():
         if IN_CI:
             pytest.fail(f"headless OpenGL is required under CI=true: {err}")
         pytest.skip(f"no headless OpenGL: {err}")
+
+
+# --- the real browser (tests/test_view.py, tests/test_browser.py) --------------------------
+# Headless Chromium on this GPU-less machine: WebGL2 through ANGLE on SwiftShader, and
+# WebGPU through Dawn on SwiftShader's Vulkan. `--enable-unsafe-webgpu` and
+# `--use-webgpu-adapter=swiftshader` give WebGPU an adapter; presenting to a WebGPU
+# canvas also needs `--enable-features=Vulkan --use-vulkan=swiftshader` (without them
+# compute work runs but a canvas frame fails with "A valid external Instance reference no
+# longer exists"). `--allow-file-access-from-files` lets a file:// page import the
+# three.js ES modules beside it (module scripts need CORS, which file:// lacks).
+CHROMIUM_FLAGS = (
+    "--enable-unsafe-webgpu",
+    "--use-webgpu-adapter=swiftshader",
+    "--enable-features=Vulkan",
+    "--use-vulkan=swiftshader",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--allow-file-access-from-files",
+)
+
+
+def _require(what: str, reason: str):
+    if IN_CI:
+        pytest.fail(f"{what} is required under CI=true: {reason} (run `make setup`)")
+    pytest.skip(f"{what} not available: {reason} (run `make setup`)")
+
+
+def chromium_path() -> str:
+    """The system Chromium (Debian's `chromium`; IMPLC_CHROMIUM overrides)."""
+    path = os.environ.get("IMPLC_CHROMIUM") or shutil.which("chromium") \
+        or shutil.which("chromium-browser")
+    if not path:
+        _require("chromium", "no chromium on PATH")
+    return path
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """One headless Chromium for the whole session (starting one costs ~0.5 s)."""
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        _require("playwright", "the Python package is not installed")
+    executable = chromium_path()
+    with sync_playwright() as playwright:
+        try:
+            chromium = playwright.chromium.launch(executable_path=executable,
+                                                  args=list(CHROMIUM_FLAGS))
+        except Exception as err:  # playwright's Error: the browser did not start
+            _require("a working chromium", f"{executable} did not start: {err}")
+        try:
+            yield chromium
+        finally:
+            chromium.close()

@@ -24,7 +24,8 @@ def test_wheel_finds_templates_and_examples(tmp_path):
         check=True, capture_output=True, timeout=300,
     )
     templates = site / "implc" / "templates"
-    for name in ("marcher.j2", "glsl/lang.j2", "opencl/probe.cl", "baseline/cross-cap.frag.j2"):
+    for name in ("marcher.j2", "glsl/lang.j2", "opencl/probe.cl", "baseline/cross-cap.frag.j2",
+                 "view/viewer.html.j2"):
         assert (templates / name).is_file(), name
     # Run from an unrelated directory with only the installed copy on the path.
     env = {**os.environ, "PYTHONPATH": str(site)}

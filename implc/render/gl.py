@@ -7,11 +7,12 @@ Rows are flipped on readback so row 0 is the top of the image, like every runner
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from functools import lru_cache
 
 import numpy as np
 
-from ..emit import emit, render_template
+from ..emit import ParamUniform, emit, param_uniforms, render_template
 from ..errors import ToolError
 from ..methods import Constants
 from ..scene import View
@@ -42,7 +43,8 @@ def renderer_name() -> str:
 class GlRunner(TimedRunner):
     """A compiled program and its framebuffer; `frame()` renders and reads back once."""
 
-    def __init__(self, fragment: str, vertex: str, view: View, width: int, height: int):
+    def __init__(self, fragment: str, vertex: str, view: View, width: int, height: int,
+                 params: Sequence[ParamUniform] = ()):
         ctx = context()
         try:
             self.program = ctx.program(vertex_shader=vertex, fragment_shader=fragment)
@@ -65,6 +67,16 @@ class GlRunner(TimedRunner):
         for name, value in uniforms.items():
             if name in self.program:
                 self.program[name].value = value
+        self.params = {p.name: p.uniform for p in params}
+        self.set_params({p.name: p.value for p in params})
+
+    def set_params(self, values: Mapping[str, float]) -> None:
+        """New parameter values for the next frames (a `--params uniform` program): set
+        as uniforms, nothing is compiled again."""
+        for name, value in values.items():
+            uniform = self.params[name]
+            if uniform in self.program:  # the driver drops a uniform the code never reads
+                self.program[uniform].value = float(value)
 
     def draw(self) -> None:
         """Render one frame and wait for it (glFinish), without reading it back."""
@@ -87,8 +99,10 @@ class GlRunner(TimedRunner):
 
 
 def open_gl_runner(surface: Surface, method: str, constants: Constants, width: int,
-                   height: int) -> GlRunner:
-    """Runner factory of backend `gl`: the 330 core program over a full-screen triangle."""
-    fragment = emit(surface, "glsl", method, constants, flavor="330")
+                   height: int, params: str = "constant") -> GlRunner:
+    """Runner factory of backend `gl`: the 330 core program over a full-screen triangle
+    (params="uniform": the parameters are uniforms, moved by `set_params`)."""
+    fragment = emit(surface, "glsl", method, constants, flavor="330", params=params)
     vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
-    return GlRunner(fragment, vertex, surface.view, width, height)
+    uniforms = param_uniforms(surface, "glsl") if params == "uniform" else ()
+    return GlRunner(fragment, vertex, surface.view, width, height, uniforms)

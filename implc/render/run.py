@@ -25,6 +25,11 @@ class Runner(Protocol):
     def release(self) -> None: ...
 
 
+# A runner opened with params="uniform" (gl, wgpu) also has
+#   set_params(values: Mapping[str, float]) -> None
+# which moves the parameters for the next frames without compiling anything again.
+
+
 class _ReferenceRunner:
     """The exact CPU reference; it has no method, so `method` and `constants` are ignored."""
 
@@ -52,14 +57,20 @@ BACKENDS: dict[str, Backend] = {
 
 
 def open_runner(
-    surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int
+    surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
+    params: str = "constant",
 ) -> Runner:
+    """`params="uniform"`: the program reads the parameters from uniforms, set from the
+    surface's values (the CPU reference always uses the values as they are)."""
     if backend == REFERENCE:
         return _ReferenceRunner(surface, width, height)
     if backend not in BACKENDS:
         choices = ", ".join([*BACKENDS, REFERENCE])
         raise ValueError(f"unknown backend '{backend}'; choose from {choices}")
-    return resolve(BACKENDS[backend].runner)(surface, method, constants, width, height)
+    factory = resolve(BACKENDS[backend].runner)
+    if params == "constant":  # every factory's signature, as before
+        return factory(surface, method, constants, width, height)
+    return factory(surface, method, constants, width, height, params=params)
 
 
 def backend_for(backend: str, precision: str | None) -> str:
@@ -77,11 +88,12 @@ def backend_for(backend: str, precision: str | None) -> str:
 
 
 def render(
-    surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int
+    surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
+    params: str = "constant",
 ) -> RenderResult:
     """Image and aux buffers of one frame; timing holds `setup` and `frame` seconds."""
     start = time.perf_counter()
-    runner = open_runner(surface, backend, method, constants, width, height)
+    runner = open_runner(surface, backend, method, constants, width, height, params)
     setup = time.perf_counter() - start
     try:
         result = runner.frame()
@@ -92,7 +104,8 @@ def render(
 
 
 def metadata(
-    surface: Surface, backend: str, method: str, constants: Constants, result: RenderResult
+    surface: Surface, backend: str, method: str, constants: Constants, result: RenderResult,
+    params: str = "constant",
 ) -> dict:
     """The JSON sidecar: enough to recompute every pixel's ray and to reproduce the run."""
     method_json = {"name": REFERENCE} if backend == REFERENCE else {
@@ -103,6 +116,7 @@ def metadata(
             "equation": surface.equation,
             "params": surface.params_json(),
         },
+        "params": params,
         "camera": surface.view.camera_json(result.width, result.height),
         "clip": surface.view.clip_json(),
         "method": method_json,
@@ -118,9 +132,10 @@ def metadata(
 
 def render_surface(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
-    output: Path,
+    output: Path, params: str = "constant",
 ) -> list[Path]:
     from .image_io import write_render
 
-    result = render(surface, backend, method, constants, width, height)
-    return write_render(result, output, metadata(surface, backend, method, constants, result))
+    result = render(surface, backend, method, constants, width, height, params)
+    return write_render(result, output,
+                        metadata(surface, backend, method, constants, result, params))

@@ -11,10 +11,12 @@ This module is not named `wgpu.py`: that would shadow the wgpu package.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+
 import numpy as np
 
 from ..devices import wgpu_device
-from ..emit import emit
+from ..emit import ParamUniform, emit, param_uniforms
 from ..errors import ToolError
 from ..scene import View
 from .result import RenderResult, TimedRunner
@@ -24,11 +26,15 @@ COLOR_FORMAT = "rgba32float"  # storage-writable in core WebGPU, and exact like 
 UNIFORM_FLOATS = 20  # struct Uniforms: 80 bytes (README "Drop-in contract (WGSL)")
 
 
-def _uniforms(view: View, width: int, height: int) -> bytes:
-    """The 80-byte `Uniforms` block, laid out as the WGSL uniform address space requires
+def _uniforms(view: View, width: int, height: int,
+              params: Sequence[ParamUniform] = (), values: Mapping[str, float] | None = None,
+              ) -> bytes:
+    """The `Uniforms` block, laid out as the WGSL uniform address space requires
     (vec3<f32> aligned to 16 bytes): offsets 0 resolution, 8 fov_y, 12 clip_radius,
-    16 eye, 32 target, 48 up, 64 clip_center."""
-    data = np.zeros(UNIFORM_FLOATS, np.float32)
+    16 eye, 32 target, 48 up, 64 clip_center (80 bytes); with `--params uniform` one f32
+    per parameter from offset 76 (`ParamUniform.offset`), rounded up to 16 bytes."""
+    end = max([UNIFORM_FLOATS * 4] + [p.offset + 4 for p in params])
+    data = np.zeros(-(-end // 16) * 4, np.float32)
     data[0:2] = (width, height)
     data[2] = view.fov_y_deg
     data[3] = view.clip_radius
@@ -36,17 +42,22 @@ def _uniforms(view: View, width: int, height: int) -> bytes:
     data[8:11] = view.target
     data[12:15] = view.up
     data[16:19] = view.clip_center
+    for p in params:
+        data[p.offset // 4] = p.value if values is None else values[p.name]
     return data.tobytes()
 
 
 class WgpuRunner(TimedRunner):
     """A compiled compute pipeline and its output resources; `frame()` renders once."""
 
-    def __init__(self, program: str, view: View, width: int, height: int):
+    def __init__(self, program: str, view: View, width: int, height: int,
+                 params: Sequence[ParamUniform] = ()):
         import wgpu
 
         dev = wgpu_device()
         self.device, self.width, self.height = dev, width, height
+        self.view, self.params = view, tuple(params)
+        self.values = {p.name: p.value for p in self.params}  # set_params keeps the rest
         aux_bytes = width * height * 16
         if aux_bytes > dev.limits["max-storage-buffer-binding-size"]:
             raise ToolError(f"wgpu: a {width}x{height} aux buffer ({aux_bytes} bytes) exceeds "
@@ -70,7 +81,8 @@ class WgpuRunner(TimedRunner):
             raise ToolError(f"wgpu rejected the shader: {err}") from err
         usage = wgpu.BufferUsage
         self.uniforms = dev.create_buffer_with_data(
-            data=_uniforms(view, width, height), usage=usage.UNIFORM)
+            data=_uniforms(view, width, height, self.params),
+            usage=usage.UNIFORM | usage.COPY_DST)
         self.color = dev.create_texture(
             size=(width, height, 1), format=COLOR_FORMAT,
             usage=wgpu.TextureUsage.STORAGE_BINDING | wgpu.TextureUsage.COPY_SRC)
@@ -85,6 +97,16 @@ class WgpuRunner(TimedRunner):
             {"binding": 1, "resource": self.color.create_view()},
             {"binding": 2, "resource": {"buffer": self.aux}},
         ])
+
+    def set_params(self, values: Mapping[str, float]) -> None:
+        """New parameter values for the next frames (a `--params uniform` program): the
+        uniform buffer is rewritten, nothing is compiled again."""
+        unknown = set(values) - set(self.values)
+        if unknown:
+            raise KeyError(f"not a uniform parameter: {', '.join(sorted(unknown))}")
+        self.values.update({k: float(v) for k, v in values.items()})
+        self.device.queue.write_buffer(self.uniforms, 0, _uniforms(
+            self.view, self.width, self.height, self.params, self.values))
 
     def draw(self) -> None:
         """Record and submit one frame: the compute pass and the copies out of it."""
@@ -122,7 +144,10 @@ class WgpuRunner(TimedRunner):
         self.color.destroy()
 
 
-def open_wgpu_runner(surface, method, constants, width: int, height: int) -> WgpuRunner:
-    """Runner factory of backend `wgpu`: emit the WGSL program and compile it."""
-    program = emit(surface, "wgsl", method, constants)
-    return WgpuRunner(program, surface.view, width, height)
+def open_wgpu_runner(surface, method, constants, width: int, height: int,
+                     params: str = "constant") -> WgpuRunner:
+    """Runner factory of backend `wgpu`: emit the WGSL program and compile it
+    (params="uniform": the parameters are uniform fields, moved by `set_params`)."""
+    program = emit(surface, "wgsl", method, constants, params=params)
+    uniforms = param_uniforms(surface, "wgsl") if params == "uniform" else ()
+    return WgpuRunner(program, surface.view, width, height, uniforms)

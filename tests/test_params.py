@@ -1,0 +1,171 @@
+"""`--params uniform`: parameters stay symbols and become uniforms the host sets.
+
+- the symbolic expression is the substituted one once the values are put back (every
+  bundled example with parameters, numerically at seeded random points);
+- every uniform emit validates with its real compiler, and declares what the README says;
+- a runner opened once renders new parameter values through set_params without compiling
+  again, and each frame is the constant-parameter render of those values (the same
+  algorithm with the same values: they differ only by float32 rounding of the folded
+  constants, so the hit masks agree on >= 99.9 % of the pixels and SSIM >= 0.999).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+import sympy
+from conftest import require_gl
+from test_cli import implc
+
+from implc.emit import emit, param_uniforms
+from implc.errors import InputError
+from implc.methods import METHODS
+from implc.metrics import compare
+from implc.parse import param_symbol
+from implc.render.run import open_runner, render
+from implc.surface import example_paths, load_surface
+from implc.symbols import X, Y, Z
+
+WITH_PARAMS = [n for n in example_paths() if load_surface(n).params]
+SIZE = 64
+
+
+def hessian():
+    return METHODS["hessian"].defaults
+
+
+def test_examples_with_parameters_exist():
+    assert {"torus", "kummer", "sphere", "gyroid", "barth-sextic"} <= set(WITH_PARAMS)
+
+
+@pytest.mark.parametrize("example", WITH_PARAMS)
+def test_symbolic_expression_is_the_substituted_one(example):
+    surface = load_surface(example)
+    assert {s.name for s in surface.symbolic.free_symbols} - {"x", "y", "z"} == set(
+        surface.params)
+    back = surface.symbolic.xreplace({param_symbol(k): v for k, v in surface.params.items()})
+    rng = np.random.default_rng(7)
+    for point in rng.uniform(-1.2, 1.2, size=(6, 3)):
+        at = dict(zip((X, Y, Z), (sympy.Float(c) for c in point), strict=True))
+        a, b = float(back.xreplace(at)), float(surface.expr.xreplace(at))
+        assert a == pytest.approx(b, rel=1e-9, abs=1e-9)
+
+
+def test_constant_exponents_keep_their_value_variable_ones_stay_symbols():
+    surface = load_surface(equation="x^n + y^2 + z^2 - a^2 + exp(-k x^2)",
+                           params=["n=2", "a=0.8", "k=3"])
+    assert surface.uniform_params() == ["a", "k"]  # n decides what x^n means: baked
+    text = emit(surface, "glsl", "sign", METHODS["sign"].defaults, params="uniform")
+    assert "u_param_a" in text and "u_param_k" in text and "u_param_n" not in text
+    assert "x*x" in text or "x_2" in text
+
+
+def test_constant_is_the_default_and_unchanged():
+    surface = load_surface("torus")
+    assert emit(surface) == emit(surface, params="constant")
+    assert "u_param" not in emit(surface)
+    assert "uniform float u_param_R;" in emit(surface, params="uniform")
+
+
+@pytest.mark.parametrize("flavor", ["330", "450", "es300"])
+@pytest.mark.parametrize("example", ["torus", "kummer"])
+def test_glsl_uniform_programs_validate(flavor, example):
+    from implc.validate import validate_text
+
+    surface = load_surface(example)
+    text = emit(surface, "glsl", "hessian", hessian(), flavor=flavor, params="uniform")
+    for p in param_uniforms(surface, "glsl"):
+        assert re.search(rf"^uniform float {p.uniform};", text, re.M)
+    verdict = validate_text(text, "glsl", f"{example}.frag")
+    assert verdict.ok, verdict.render(f"{example}.frag")
+
+
+def test_glsl_uniform_library_declares_prefixed_uniforms():
+    from implc.validate import validate_text
+
+    surface = load_surface("torus")
+    text = emit(surface, "glsl", "hessian", hessian(), emit="library", prefix="to_",
+                params="uniform")
+    assert "uniform float to_u_param_R;" in text and "uniform float to_u_param_r;" in text
+    assert not re.search(r"(?<![A-Za-z_])u_param_", text)
+    verdict = validate_text(text, "glsl", "torus.glsl")
+    assert verdict.ok, verdict.render("torus.glsl")
+
+
+def test_wgsl_uniform_program_and_library_validate():
+    from test_wgsl import validate
+
+    surface = load_surface("torus")
+    program = emit(surface, "wgsl", "hessian", hessian(), params="uniform")
+    assert "    u_param_R: f32," in program and "// offset 76: parameter R" in program
+    assert "// offset 80: parameter r" in program and "struct size 96" in program
+    assert validate(program, "torus.wgsl").ok
+    library = emit(surface, "wgsl", "hessian", hessian(), emit="library", prefix="to_",
+                   params="uniform")
+    assert "var<private> to_params: to_Params = to_Params(1.0f, 0.35f);" in library
+    assert validate(library, "torus-lib.wgsl").ok
+    assert [p.offset for p in param_uniforms(surface, "wgsl")] == [76, 80]
+
+
+def test_uniform_refusals():
+    surface = load_surface("torus")
+    with pytest.raises(InputError, match="shadertoy"):
+        emit(surface, "glsl", flavor="shadertoy", params="uniform")
+    with pytest.raises(InputError, match="opencl"):
+        emit(surface, "opencl", params="uniform")
+    with pytest.raises(InputError, match="--params"):
+        emit(surface, params="baked")
+    odd = load_surface(equation="x^2 + y^2 + z^2 - a__b", params=["a__b=1"])
+    with pytest.raises(InputError, match="reserved"):
+        emit(odd, params="uniform")
+    # a surface without parameters: uniform is the constant program
+    sphere = load_surface(equation="x^2 + y^2 + z^2 - 1")
+    assert emit(sphere, params="uniform") == emit(sphere)
+
+
+@pytest.mark.parametrize("backend", ["gl", "wgpu"])
+def test_runner_moves_parameters_without_compiling(backend):
+    if backend == "gl":
+        require_gl()
+    else:
+        from test_wgsl import require_wgpu
+
+        require_wgpu()
+    surface = load_surface("torus")
+    runner = open_runner(surface, backend, "hessian", hessian(), SIZE, SIZE, params="uniform")
+    compiled = runner.program if backend == "gl" else runner.pipeline
+    steps = (({}, []), ({"r": 0.5}, ["r=0.5"]), ({"R": 0.8}, ["R=0.8", "r=0.5"]))
+    frames = []
+    try:
+        for values, _ in steps:  # set_params keeps the values it is not given
+            if values:
+                runner.set_params(values)
+            frames.append(runner.frame())
+        assert (runner.program if backend == "gl" else runner.pipeline) is compiled
+    finally:
+        runner.release()
+    for i, ((_, params), frame) in enumerate(zip(steps, frames, strict=True)):
+        expected = render(load_surface("torus", params=params), backend, "hessian", hessian(),
+                          SIZE, SIZE)
+        m = compare(frame, expected)
+        assert m["hit_agreement"] >= 0.999 and m["ssim"] >= 0.999, (params, m)
+        if i:  # the picture really changed
+            assert compare(frame, frames[i - 1])["hit_agreement"] < 0.98
+
+
+def test_cli_render_and_compile_take_params(tmp_path):
+    require_gl()
+    out = tmp_path / "u.png"
+    proc = implc("render", "torus", "--params", "uniform", "--param", "r=0.5", "--size", "48",
+                 "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    meta = json.loads(out.with_suffix(".json").read_text())
+    assert meta["params"] == "uniform" and meta["surface"]["params"]["r"] == 0.5
+    proc = implc("compile", "kummer", "-t", "wgsl", "--params", "uniform", "--validate")
+    assert proc.returncode == 0, proc.stderr
+    assert "u_param_mu: f32," in proc.stdout
+    proc = implc("compile", "torus", "--params", "uniform", "--flavor", "shadertoy")
+    assert proc.returncode == 1 and "shadertoy" in proc.stderr
