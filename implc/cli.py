@@ -60,6 +60,37 @@ exit codes: 0 ok, 1 bad input or output (file missing, unreadable or unwritable,
 DEBUG_ENV = "IMPLC_DEBUG"
 
 
+class StdoutError(ImplcError):
+    """Standard output cannot be written (a full disk under `> file`, a closed or
+    read-only descriptor): exit code 1, like any output that cannot be written."""
+
+
+class _GuardedStdout:
+    """sys.stdout, with write errors turned into StdoutError (a closed pipe stays a
+    BrokenPipeError: the reader left, which is not an error)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _guard(self, call, *args):
+        try:
+            return call(*args)
+        except BrokenPipeError:
+            raise
+        except OSError as err:
+            raise StdoutError(f"cannot write to standard output: {describe_os_error(err)}"
+                              ) from None
+
+    def write(self, text):
+        return self._guard(self._stream.write, text)
+
+    def flush(self):
+        return self._guard(self._stream.flush)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 class Terminated(BaseException):
     """SIGTERM, raised like KeyboardInterrupt so temporary files are cleaned up."""
 
@@ -81,6 +112,8 @@ def _install_signals() -> dict:
 def main(argv: list[str] | None = None) -> int:
     previous = _install_signals()
     command = "implc"
+    stdout = sys.stdout
+    sys.stdout = _GuardedStdout(stdout)
     try:
         parser = build_parser()
         args = parser.parse_args(_join_equation_values(sys.argv[1:] if argv is None else argv))
@@ -97,6 +130,8 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.flush()  # a full disk under `> file` is reported here, not at exit
         return code
     except ImplcError as err:
+        if isinstance(err, StdoutError):
+            _detach_stdout()  # what is still buffered would fail again at exit
         print(err.render(), file=sys.stderr)
         return err.exit_code
     except KeyboardInterrupt:
@@ -115,13 +150,13 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as err:
         if err.errno not in FULL_DISK:
             return _internal_error(command, err)
-        _detach_stdout()  # what is still buffered would fail again at exit
         print(f"implc: error: cannot write the output: {describe_os_error(err)}",
               file=sys.stderr)
         return EXIT_INPUT
     except Exception as err:  # a bug: one line, the traceback on request
         return _internal_error(command, err)
     finally:
+        sys.stdout = stdout
         for sig, handler in previous.items():
             signal.signal(sig, handler)
 

@@ -171,7 +171,12 @@ def staged_directory(out_dir: Path | str) -> Iterator[Path]:
     except OSError as err:
         raise OutputError(f"cannot write {out_dir}: {_describe(err)}") from None
     try:
-        yield stage
+        try:
+            yield stage
+        except OutputError as err:  # name the file as the user will know it
+            err.message = err.message.replace(str(stage), str(out_dir))
+            err.args = (err.message,)
+            raise
         if not out_dir.exists():
             os.chmod(stage, 0o777 & ~_umask())
             os.replace(stage, out_dir)
