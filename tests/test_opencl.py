@@ -61,7 +61,7 @@ def test_golden(case, update_golden):
         require_opencl()
 
     def build(text: str):
-        if "cl_khr_fp64" in text and not cl_runner.device().has_fp64:
+        if "cl_khr_fp64" in text and not devices.opencl_device().has_fp64:
             pytest.skip("this OpenCL device has no cl_khr_fp64")
         return validate_opencl(text, name)
 
