@@ -39,9 +39,10 @@ from typing import TextIO
 
 from . import __version__
 from .errors import InputError
-from .fileio import write_atomic, write_with
+from .fileio import staged_directory, write_atomic, write_with
 from .methods import METHODS
 from .metrics import T_TOL, compare
+from .progress import Progress
 from .render.result import RenderResult
 from .render.run import BACKENDS, metadata, open_runner
 from .surface import Surface
@@ -141,7 +142,8 @@ class BenchRun:
     machine: dict
     reference_seconds: dict[str, float] = field(default_factory=dict)
     cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)  # (config, surf, m)
-    # the hand-written programs (implc/baseline.py), timed in turns with the generated ones
+    baseline: bool = False  # time the hand-written programs too (implc/baseline.py)
+    # the hand-written programs, timed in turns with the generated ones
     baseline_cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)
     tiles: dict[tuple[str, str, str], object] = field(default_factory=dict)  # PIL thumbnails
 
@@ -260,83 +262,100 @@ def run_bench(
     `surfaces` maps a short key (file stem, e.g. "cross-cap") to the loaded surface.
     With `baseline`, the hand-written programs of implc/baseline.py (GL only) are timed
     in the same rounds as the generated ones.
+    Progress goes to `progress`: a bar with an ETA on a terminal, numbered lines otherwise.
     """
-    from .baseline import has_baseline, open_baseline_runner
-    from .figure import tile_image
-    from .render.image_io import write_render
-
     _check_args(surfaces, size, methods, frames, backend, equal_step)
     bench_configs = make_configs(configs, equal_step)
     out_dir = Path(out_dir)
+    # every file goes to a staging directory that moves into out_dir at the end: an
+    # error, Ctrl-C or SIGTERM midway leaves no partial run behind (implc.fileio)
+    with staged_directory(out_dir) as stage:
+        run = _measure(surfaces, stage, size, methods, frames, backend, bench_configs, exr,
+                       progress, baseline)
+        write_outputs(run, stage)
+    _printer(progress)(f"wrote {out_dir / 'table.md'}, table.json, figure.png, renders/")
+    return run
+
+
+def _measure(surfaces, out_dir: Path, size, methods, frames, backend, bench_configs, exr,
+             progress, baseline: bool = False) -> BenchRun:
+    from .figure import tile_image
+    from .render.image_io import write_render
+
     renders = out_dir / "renders"
     renders.mkdir(parents=True, exist_ok=True)
     run = BenchRun(size, frames, backend, list(methods), bench_configs, dict(surfaces),
                    machine_info(backend))
-    say = _printer(progress)
-    say(f"bench: {len(surfaces)} surface(s), {size}x{size}, {frames} frame(s) after 1 warm-up, "
-        f"backend {backend} ({run.machine.get('gl_renderer', '?')})")
-
-    references: dict[str, RenderResult] = {}
-    for key, surface in surfaces.items():
-        start = time.perf_counter()
-        unused = METHODS["taylor"].defaults  # the reference has no method constants
-        ref = open_runner(surface, "reference", "", unused, size, size).frame()
-        run.reference_seconds[key] = time.perf_counter() - start
-        references[key] = ref
-        name = f"{key}-reference.png"
-        write_render(ref, renders / name, metadata(surface, "reference", "", unused, ref))
-        run.tiles["reference", key, "reference"] = tile_image(ref.color, TILE)
-        say(f"reference {key}: {run.reference_seconds[key]:.2f} s")
-
+    run.baseline = baseline
     total = sum(len(surfaces) * len(c.applies_to(methods)) for c in bench_configs)
-    done = 0
-    for config in bench_configs:
-        say(f"{config.name}: {config.title}")
-        chosen = config.applies_to(methods)
+    bar = Progress(total, "bench", progress, unit="cell")
+    bar.note(f"bench: {len(surfaces)} surface(s), {size}x{size}, {frames} frame(s) after 1 "
+             f"warm-up, backend {backend} ({run.machine.get('gl_renderer', '?')})")
+    try:
+        references: dict[str, RenderResult] = {}
         for key, surface in surfaces.items():
-            constants = [METHODS[m].constants(**config.overrides) for m in chosen]
-            hand = [m for m in chosen if baseline and backend == "gl" and has_baseline(key, m)]
-            runners, setup = [], []
-            try:
-                for method, method_constants in zip(chosen, constants, strict=True):
-                    start = time.perf_counter()
-                    runners.append(
-                        open_runner(surface, backend, method, method_constants, size, size))
-                    setup.append(time.perf_counter() - start)
-                for method in hand:
-                    runners.append(open_baseline_runner(
-                        key, method, constants[chosen.index(method)], surface, size, size))
-                seconds, results = time_interleaved(runners, frames)
-            finally:
-                for runner in runners:
-                    runner.release()
-            for index, method in enumerate(chosen):
-                done += 1
-                result = results[index]
-                fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
-                stem = f"{key}-{method}-{config.name}"
-                meta = metadata(surface, backend, method, constants[index], result)
-                write_render(result, renders / f"{stem}.png", meta)
-                if exr:
-                    write_render(result, renders / f"{stem}.exr", meta)
-                run.cells[config.name, key, method] = Cell(
-                    fps, seconds[index], setup[index], compare(result, references[key]),
-                    f"renders/{stem}.png")
-                run.tiles[config.name, key, method] = tile_image(result.color, TILE)
-                say(f"[{done:>{len(str(total))}}/{total}] {key} {method} {config.name}: "
-                    f"{fps:.3g} fps")
-            for offset, method in enumerate(hand):
-                index = len(chosen) + offset
-                fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
-                run.baseline_cells[config.name, key, method] = Cell(
-                    fps, seconds[index], 0.0, compare(results[index], references[key]), "")
-                say(f"    {key} {method} {config.name}, hand-written baseline: {fps:.3g} fps")
-            del results
+            start = time.perf_counter()
+            unused = METHODS["taylor"].defaults  # the reference has no method constants
+            ref = open_runner(surface, "reference", "", unused, size, size).frame()
+            run.reference_seconds[key] = time.perf_counter() - start
+            references[key] = ref
+            name = f"{key}-reference.png"
+            write_render(ref, renders / name, metadata(surface, "reference", "", unused, ref))
+            run.tiles["reference", key, "reference"] = tile_image(ref.color, TILE)
+            bar.note(f"reference {key}: {run.reference_seconds[key]:.2f} s")
+        for config in bench_configs:
+            bar.note(f"{config.name}: {config.title}")
+            chosen = config.applies_to(methods)
+            for key, surface in surfaces.items():
+                _measure_surface(run, config, chosen, key, surface, references[key], renders,
+                                 exr, bar)
+    finally:
+        bar.close()
     run.machine["load_average_end"] = _load_average()
     _fill_ratios(run)
-    write_outputs(run, out_dir)
-    say(f"wrote {out_dir / 'table.md'}, table.json, figure.png, renders/")
     return run
+
+
+def _measure_surface(run, config, chosen, key, surface, reference, renders, exr, bar) -> None:
+    from .baseline import has_baseline, open_baseline_runner
+    from .figure import tile_image
+    from .render.image_io import write_render
+
+    size, backend = run.size, run.backend
+    constants = [METHODS[m].constants(**config.overrides) for m in chosen]
+    hand = [m for m in chosen if run.baseline and backend == "gl" and has_baseline(key, m)]
+    runners, setup = [], []
+    try:
+        for method, method_constants in zip(chosen, constants, strict=True):
+            start = time.perf_counter()
+            runners.append(open_runner(surface, backend, method, method_constants, size, size))
+            setup.append(time.perf_counter() - start)
+        for method in hand:
+            runners.append(open_baseline_runner(key, method, constants[chosen.index(method)],
+                                                surface, size, size))
+        seconds, results = time_interleaved(runners, run.frames)
+    finally:
+        for runner in runners:
+            runner.release()
+    for index, method in enumerate(chosen):
+        result = results[index]
+        fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
+        stem = f"{key}-{method}-{config.name}"
+        meta = metadata(surface, backend, method, constants[index], result)
+        write_render(result, renders / f"{stem}.png", meta)
+        if exr:
+            write_render(result, renders / f"{stem}.exr", meta)
+        run.cells[config.name, key, method] = Cell(
+            fps, seconds[index], setup[index], compare(result, reference),
+            f"renders/{stem}.png")
+        run.tiles[config.name, key, method] = tile_image(result.color, TILE)
+        bar.step(f"{key} {method} {config.name}: {fps:.3g} fps")
+    for offset, method in enumerate(hand):
+        index = len(chosen) + offset
+        fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
+        run.baseline_cells[config.name, key, method] = Cell(
+            fps, seconds[index], 0.0, compare(results[index], reference), "")
+        bar.note(f"{key} {method} {config.name}, hand-written baseline: {fps:.3g} fps")
 
 
 def _check_args(surfaces, size, methods, frames, backend, equal_step) -> None:

@@ -1,21 +1,38 @@
 """The `implc` command: argument parsing and exit codes only; the work is in the library.
 
-Exit codes: 0 ok, 1 bad input (equation, surface file, parameter), 2 bad command line,
-3 a shader failed validation, 4 a tool or runtime is missing or failed, 130 interrupted.
+Exit codes (README "Exit codes"): 0 ok; 1 bad input or output (equation, surface file,
+parameter, a missing or unreadable input, an output that cannot be written, a full disk);
+2 bad command line; 3 a shader failed validation; 4 a tool or runtime is missing or
+failed; 70 internal error (a bug: rerun with IMPLC_DEBUG=1 for the traceback);
+130 interrupted (SIGINT); 143 terminated (SIGTERM). Every output path is checked before
+any work starts (implc.fileio.check_output).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import re
+import signal
 import sys
 import time
+import traceback
 from pathlib import Path
 
 from . import __version__
-from .errors import EXIT_INTERRUPTED, EXIT_OK, ImplcError, InputError, ValidationError
-from .fileio import write_atomic
+from .errors import (
+    EXIT_INPUT,
+    EXIT_INTERNAL,
+    EXIT_INTERRUPTED,
+    EXIT_INVALID,
+    EXIT_OK,
+    EXIT_TERMINATED,
+    ImplcError,
+    InputError,
+    ValidationError,
+)
+from .fileio import FULL_DISK, check_output, check_output_dir, describe_os_error, write_atomic
 from .marcher import AUTO_MAX_DEGREE, EVAL_CHOICES, EXACT_MAX_DEGREE
 from .methods import METHODS, TAYLOR2_CHOICES, Constants
 from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
@@ -36,37 +53,131 @@ examples:
   implc compare cc-hessian.exr cc-reference.exr
   implc bench cross-cap miter steiner --size 512 -o results/
 
-exit codes: 0 ok, 1 bad input, 2 bad command line, 3 validation failed,
-            4 tool or runtime missing, 130 interrupted
+exit codes: 0 ok, 1 bad input or output (file missing, unreadable or unwritable,
+            disk full), 2 bad command line, 3 validation failed, 4 tool or runtime
+            missing, 70 internal error (IMPLC_DEBUG=1 shows the traceback),
+            130 interrupted (SIGINT), 143 terminated (SIGTERM)
 """
+
+DEBUG_ENV = "IMPLC_DEBUG"
+
+
+class StdoutError(ImplcError):
+    """Standard output cannot be written (a full disk under `> file`, a closed or
+    read-only descriptor): exit code 1, like any output that cannot be written."""
+
+
+class _GuardedStdout:
+    """sys.stdout, with write errors turned into StdoutError (a closed pipe stays a
+    BrokenPipeError: the reader left, which is not an error)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _guard(self, call, *args):
+        try:
+            return call(*args)
+        except BrokenPipeError:
+            raise
+        except OSError as err:
+            raise StdoutError(f"cannot write to standard output: {describe_os_error(err)}"
+                              ) from None
+
+    def write(self, text):
+        return self._guard(self._stream.write, text)
+
+    def flush(self):
+        return self._guard(self._stream.flush)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised like KeyboardInterrupt so temporary files are cleaned up."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
+def _install_signals() -> dict:
+    """SIGTERM ends the run cleanly (exit 143); SIGXFSZ is ignored so that a file-size
+    limit (RLIMIT_FSIZE) shows as an EFBIG write error instead of killing the process."""
+    previous = {}
+    for sig, handler in ((signal.SIGTERM, _on_sigterm), (signal.SIGXFSZ, signal.SIG_IGN)):
+        with contextlib.suppress(ValueError, OSError):  # not the main thread
+            previous[sig] = signal.signal(sig, handler)
+    return previous
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(_join_equation_values(sys.argv[1:] if argv is None else argv))
-    if getattr(args, "equation", None) == []:  # argparse drops a value that is exactly "--"
-        args.equation = "--"
-    if not getattr(args, "command", None):
-        parser.print_help()
-        return EXIT_OK
+    previous = _install_signals()
+    command = "implc"
+    stdout = sys.stdout
+    sys.stdout = _GuardedStdout(stdout)
     try:
+        parser = build_parser()
+        args = parser.parse_args(_join_equation_values(sys.argv[1:] if argv is None else argv))
+        command = getattr(args, "command", None) or "implc"
+        if getattr(args, "equation", None) == []:  # argparse drops a value that is exactly "--"
+            args.equation = "--"
+        if not getattr(args, "command", None):
+            parser.print_help()
+            return EXIT_OK
         from .derive import derive_limits
 
         with derive_limits(getattr(args, "max_derived", None)):
-            return args.run(args)
+            code = args.run(args)
+        sys.stdout.flush()  # a full disk under `> file` is reported here, not at exit
+        return code
     except ImplcError as err:
+        if isinstance(err, StdoutError):
+            _detach_stdout()  # what is still buffered would fail again at exit
         print(err.render(), file=sys.stderr)
         return err.exit_code
     except KeyboardInterrupt:
         print("implc: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated:
+        print("implc: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except BrokenPipeError:  # `implc show x | head`: the reader left; not an error
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        _detach_stdout()
         return EXIT_OK
     except RecursionError:
         print("implc: error: too complex: expression nesting exceeds Python's limits",
               file=sys.stderr)
-        return 1
+        return EXIT_INPUT
+    except OSError as err:
+        if err.errno not in FULL_DISK:
+            return _internal_error(command, err)
+        print(f"implc: error: cannot write the output: {describe_os_error(err)}",
+              file=sys.stderr)
+        return EXIT_INPUT
+    except Exception as err:  # a bug: one line, the traceback on request
+        return _internal_error(command, err)
+    finally:
+        sys.stdout = stdout
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _internal_error(command: str, err: BaseException) -> int:
+    if os.environ.get(DEBUG_ENV):
+        traceback.print_exc()
+    first = (str(err).splitlines() or [""])[0][:300]
+    what = f"{type(err).__name__}: {first}" if first else type(err).__name__
+    where = f"'implc {command}'" if command != "implc" else "implc"
+    print(f"implc: internal error in {where}: {what} (rerun with {DEBUG_ENV}=1 for the "
+          "traceback, and please report it)", file=sys.stderr)
+    return EXIT_INTERNAL
+
+
+def _detach_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's last flush has nowhere to fail."""
+    with contextlib.suppress(OSError, ValueError):
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
 def _join_equation_values(argv: list[str]) -> list[str]:
@@ -358,9 +469,18 @@ def cmd_show(args) -> int:
     return EXIT_OK
 
 
+def shader_extensions(target: str) -> tuple[str, ...]:
+    """File extensions `compile -o` writes for `target` (what `implc validate` reads back:
+    a fragment shader or library for glsl, not .vert or .comp)."""
+    return tuple(ext for ext in TARGETS[target].extensions if ext not in (".vert", ".comp"))
+
+
 def cmd_compile(args) -> int:
     from .emit import emit
 
+    if args.output:
+        check_output(args.output, shader_extensions(args.target),
+                     what=f"a {args.target} shader")
     surface = _surface(args)
     _resolve_method(args, surface)
     text = emit(surface, args.target, args.method, _constants(args), args.flavor, args.emit,
@@ -381,18 +501,43 @@ def cmd_compile(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    from .validate import validate_file
+    """Every file is checked (exists, readable, known extension, UTF-8) before any
+    compiler runs: a bad input is exit 1, a shader its compiler rejects exit 3."""
+    from .targets import target_of_file
+    from .validate import validate_text
 
-    failed = 0
+    sources = []
     for path in args.files:
-        if not path.is_file():
-            print(f"implc: error: {path}: no such file", file=sys.stderr)
-            failed += 1
-            continue
-        verdict = validate_file(path)
+        target = target_of_file(path.suffix)
+        if target is None:
+            known = " ".join(sorted(ext for t in TARGETS.values() for ext in t.extensions))
+            raise InputError(f"{path}: unknown shader extension '{path.suffix}' "
+                             f"(known: {known})")
+        sources.append((path, target.name, read_input_text(path)))
+    failed = 0
+    for path, target, text in sources:
+        verdict = validate_text(text, target, str(path))
         print(verdict.render(str(path)), file=sys.stdout if verdict.ok else sys.stderr)
         failed += not verdict.ok
-    return 3 if failed else EXIT_OK
+    return EXIT_INVALID if failed else EXIT_OK
+
+
+def read_input_text(path: Path, limit: int = 50_000_000) -> str:
+    """A text input file, or an InputError saying in one line why it cannot be read."""
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory, not a file")
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except OSError as err:
+        raise InputError(f"cannot read {path}: {(err.strerror or str(err)).lower()}") from None
+    if len(data) > limit:
+        raise InputError(f"{path}: larger than {limit} bytes")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise InputError(f"{path}: not UTF-8 text (byte {err.start})") from None
 
 
 def cmd_render(args) -> int:
@@ -400,8 +545,11 @@ def cmd_render(args) -> int:
 
     width, height = _size(args)
     backend = backend_for(args.backend, args.precision)  # a precision is a backend of its own
+    check_output(args.output, (".png", ".exr"), what="a render",
+                 companions=[args.output.with_suffix(".json")])
     surface = _surface(args)
     _resolve_method(args, surface)
+    _check_frame(surface, width, height)
     start = time.perf_counter()
     paths = render_surface(surface, backend, args.method, _constants(args), width, height,
                            args.output, params=args.params)
@@ -417,6 +565,7 @@ def cmd_render(args) -> int:
 def cmd_view(args) -> int:
     from .view import viewer_page
 
+    check_output(args.output, (".html", ".htm"), what="the viewer page")
     surface = _surface(args)
     _resolve_method(args, surface)
     page = viewer_page(surface, args.method, _constants(args), webgpu=not args.no_webgpu)
@@ -444,6 +593,7 @@ def cmd_bench(args) -> int:
     from .bench import DEFAULT_METHODS, EQUAL_STEP, run_bench
     from .surface import load_surface
 
+    check_output_dir(args.output, what="bench output directory")
     surfaces = {}
     for spec in args.surfaces:
         key = Path(spec).stem
@@ -463,6 +613,8 @@ def cmd_bench(args) -> int:
 def cmd_corpus(args) -> int:
     from . import corpus
 
+    if args.output:
+        check_output(args.output, (".md",), what="the corpus report (Markdown)")
     tsv = args.tsv or corpus.default_tsv()
     if tsv is None:
         raise InputError("no corpus found at ../shared/corpus/implicit_surface_corpus.tsv; "
@@ -473,16 +625,29 @@ def cmd_corpus(args) -> int:
         wanted = _row_numbers(args.rows)
         rows = [r for r in rows if r.number in wanted]
     jobs = corpus.effective_jobs(args.jobs)
+    from .progress import Progress
+
+    bar = Progress(len(rows), "corpus", sys.stderr, unit="row")
 
     def progress(result) -> None:
+        line = None
         if result.outcome != corpus.COMPILED:
-            print(f"row {result.row.number} ({result.row.name}): {result.outcome}: "
-                  f"{result.reason}", file=sys.stderr)
+            line = (f"row {result.row.number} ({result.row.name}): {result.outcome}: "
+                    f"{result.reason}")
+        if bar.bar is not None:
+            bar.step(f"row {result.row.number}")
+            if line:
+                bar.note(line)
+        elif line:
+            print(line, file=sys.stderr, flush=True)
 
     start = time.perf_counter()
-    results = corpus.run_corpus(rows, args.targets, validate=not args.no_validate,
-                                check=not args.no_check, jobs=jobs, limits=_limits(args),
-                                progress=progress)
+    try:
+        results = corpus.run_corpus(rows, args.targets, validate=not args.no_validate,
+                                    check=not args.no_check, jobs=jobs, limits=_limits(args),
+                                    progress=progress)
+    finally:
+        bar.close()
     wall = time.perf_counter() - start
     if args.output:
         report = corpus.render_report(results, os.path.relpath(tsv), args.targets, wall, jobs,
@@ -506,11 +671,22 @@ def _row_numbers(text: str) -> set[int]:
     return numbers
 
 
+def _check_frame(surface, width: int, height: int) -> None:
+    """A view that would render a blank frame at this size is an error, not a picture."""
+    from .scene import frame_problem
+
+    problem = frame_problem(surface.view, width, height)
+    if problem:
+        raise InputError(f"{surface.origin}: [view] {problem} ({width}x{height})")
+
+
 def _size(args) -> tuple[int, int]:
-    if args.size is not None and (args.width or args.height):
+    """--size N, or --width/--height (each defaults to the other, then to 512). A given 0
+    is an error, not "not given"."""
+    if args.size is not None and (args.width is not None or args.height is not None):
         raise InputError("give --size or --width/--height, not both")
-    width = args.width or args.size or 512
-    height = args.height or args.size or 512
+    width = next((v for v in (args.width, args.size, args.height) if v is not None), 512)
+    height = next((v for v in (args.height, args.size, args.width) if v is not None), 512)
     for value in (width, height):
         if not 1 <= value <= 8192:
             raise InputError(f"image size must be between 1 and 8192 pixels (got {value})")

@@ -27,6 +27,8 @@ def load_render(path: Path) -> tuple[RenderResult, dict]:
     if path.suffix.lower() != ".exr":
         raise InputError(f"{path}: compare reads EXR renders (write them with "
                          "`implc render ... -o NAME.exr`)")
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory, not an EXR render")
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     if not path.with_suffix(".json").is_file():

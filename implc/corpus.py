@@ -22,6 +22,7 @@ Rows are independent, so `jobs > 1` runs them in worker processes.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import re
@@ -111,10 +112,16 @@ def default_tsv() -> Path | None:
 
 def load_rows(path: Path) -> list[Row]:
     """Read a corpus TSV (the shared one, or a copy with an extra leading `row` column)."""
+    if Path(path).is_dir():
+        raise InputError(f"cannot read {path}: it is a directory, not a corpus TSV")
     try:
         text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(f"cannot read {path}: no such file") from None
     except OSError as err:
-        raise InputError(f"cannot read {path}: {err.strerror or err}") from None
+        raise InputError(f"cannot read {path}: {(err.strerror or str(err)).lower()}") from None
+    except UnicodeDecodeError as err:
+        raise InputError(f"{path}: not UTF-8 text (byte {err.start})") from None
     reader = csv.DictReader(text.splitlines(), delimiter="\t")
     missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
     if missing:
@@ -348,19 +355,46 @@ def run_corpus(
             if progress:
                 progress(results[-1])
     else:
-        # spawn, not fork: wgpu, PoCL and the GL stack hold threads and handles
-        with ProcessPoolExecutor(jobs, mp_context=get_context("spawn")) as pool:
+        # spawn, not fork: wgpu, PoCL and the GL stack hold threads and handles. Workers
+        # ignore SIGINT (Ctrl-C reaches the whole process group): the parent alone
+        # decides, stops them and reports once.
+        pool = ProcessPoolExecutor(jobs, mp_context=get_context("spawn"),
+                                   initializer=_worker_signals)
+        try:
             futures = [pool.submit(run_row, row, chosen(row), validate, check, limits)
                        for row in _costliest_first(rows)]
             for future in futures:
                 results.append(future.result())
                 if progress:
                     progress(results[-1])
+        except BaseException:
+            _stop_pool(pool)
+            raise
+        pool.shutdown(wait=True)
     results.sort(key=lambda r: r.row.number)
     missing = next((r.tool_missing for r in results if r.tool_missing), "")
     if missing:
         raise ToolError(missing)
     return results
+
+
+def _worker_signals() -> None:
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started and end the workers now (an interrupted run)."""
+    processes = list(getattr(pool, "_processes", {}).values())  # no public handle
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        with contextlib.suppress(Exception):
+            process.terminate()
+    for process in processes:
+        with contextlib.suppress(Exception):
+            process.join(5)
 
 
 def _costliest_first(rows: list[Row]) -> list[Row]:

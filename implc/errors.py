@@ -16,7 +16,9 @@ EXIT_INPUT = 1  # the equation, a surface file or a parameter is wrong
 EXIT_USAGE = 2  # the command line is wrong (argparse uses 2 as well)
 EXIT_INVALID = 3  # a shader failed validation by its real compiler
 EXIT_TOOL = 4  # a required tool or runtime is missing or failed
-EXIT_INTERRUPTED = 130
+EXIT_INTERNAL = 70  # a bug in implc: an unexpected exception (sysexits EX_SOFTWARE)
+EXIT_INTERRUPTED = 130  # SIGINT (Ctrl-C): 128 + 2
+EXIT_TERMINATED = 143  # SIGTERM: 128 + 15
 
 
 @dataclass(frozen=True)
@@ -31,10 +33,19 @@ class Source:
     text: str
     line: int = 1
     col: int = 1
+    # For text decoded from a quoted string (escapes, multi-line strings): the file's
+    # (line, col) of every character of `text` and of the position after it, and the
+    # file's lines, so a caret lands under the character as the user wrote it.
+    positions: tuple[tuple[int, int], ...] | None = None
+    file_lines: tuple[str, ...] | None = None
 
     def locate(self, offset: int) -> tuple[int, int, str, int]:
         """Map an offset into `text` to (file line, file col, line text, col in line text)."""
         offset = max(0, min(offset, len(self.text)))
+        if self.positions and self.file_lines is not None:
+            line, col = self.positions[min(offset, len(self.positions) - 1)]
+            line_text = self.file_lines[line - 1] if 0 < line <= len(self.file_lines) else ""
+            return line, col, line_text, col - 1
         before = self.text[:offset]
         line_in_text = before.count("\n")
         line_start = before.rfind("\n") + 1
@@ -75,6 +86,11 @@ class InputError(ImplcError):
         caret_len = max(1, min(self.length, len(shown) - col_in_line))
         caret = " " * col_in_line + "^" + "~" * (caret_len - 1)
         return f"{self.source.name}:{line}:{col}: error: {self.message}\n  {shown}\n  {caret}"
+
+
+class OutputError(InputError):
+    """An output that cannot be written: a missing or read-only directory, an unknown
+    extension, a directory where a file should go, a full disk (exit code 1)."""
 
 
 class LimitError(InputError):

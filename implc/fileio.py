@@ -1,14 +1,97 @@
-"""Atomic file writes: a reader (or an interrupted run) never sees a partial output file."""
+"""Output files: checked before any work starts, written atomically, never left partial.
+
+`check_output` / `check_output_dir` are what the command line calls for every output
+option (`compile -o`, `render -o`, `bench -o`, `corpus -o`, and `view -o`): the
+directory must exist (or be creatable) and be writable, the extension must be one the
+command writes, and nothing may sit in the way (a directory where a file should go).
+They raise `OutputError` (exit code 1, one line) before a second is spent rendering.
+
+`write_atomic` / `write_with` write through a temporary file in the same directory and a
+rename, so a reader, an interrupted run or a full disk never leaves a partial output;
+an `OSError` while writing (ENOSPC, EFBIG under RLIMIT_FSIZE, EIO) becomes an
+`OutputError` naming the file.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
-from .errors import InputError
+from .errors import OutputError
+
+# errno values that mean "the disk (or the process's file-size limit) is full"
+FULL_DISK = {errno.ENOSPC, errno.EFBIG, getattr(errno, "EDQUOT", errno.ENOSPC)}
+
+
+def _describe(err: OSError) -> str:
+    if err.errno == errno.EFBIG:
+        return "file too large (disk full or file-size limit reached)"
+    if err.errno == errno.ENOSPC:
+        return "no space left on the device"
+    return (err.strerror or str(err)).lower()
+
+
+def check_output(
+    path: Path | str,
+    extensions: Sequence[str] | None = None,
+    *,
+    what: str = "output",
+    companions: Sequence[Path] = (),
+) -> Path:
+    """Check, before any work, that `path` can be written as a file.
+
+    `extensions` (".png", ".exr", ...) are the ones this output may have (case-insensitive);
+    `companions` are files written beside it (a render's JSON sidecar), checked alike.
+    Probes the directory with a real temporary file (removed again), so a read-only
+    file system or missing permissions show up even for root.
+    """
+    path = Path(path)
+    if extensions is not None and path.suffix.lower() not in {e.lower() for e in extensions}:
+        known = " or ".join(extensions)
+        shown = f"'{path.suffix}'" if path.suffix else "no extension"
+        raise OutputError(f"cannot write {path}: {what} needs {known}, not {shown}")
+    for target in (path, *companions):
+        if target.is_dir():
+            raise OutputError(f"cannot write {target}: it is a directory")
+    directory = path.parent if str(path.parent) else Path(".")
+    _check_writable_dir(directory, path)
+    return path
+
+
+def check_output_dir(path: Path | str, *, what: str = "output directory") -> Path:
+    """Check, before any work, that `path` is (or can be created as) a writable directory."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise OutputError(f"cannot write {path}: the {what} is a file, not a directory")
+    existing = path
+    while not existing.exists():
+        parent = existing.parent
+        if parent == existing:
+            break
+        existing = parent
+    if not existing.is_dir():
+        raise OutputError(f"cannot create {path}: {existing} is not a directory")
+    _check_writable_dir(existing, path)
+    return path
+
+
+def _check_writable_dir(directory: Path, path: Path) -> None:
+    if not directory.exists():
+        raise OutputError(f"cannot write {path}: directory {directory} does not exist")
+    if not directory.is_dir():
+        raise OutputError(f"cannot write {path}: {directory} is not a directory")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".implc-probe-", dir=directory)
+    except OSError as err:
+        raise OutputError(f"cannot write {path}: directory {directory} is not writable "
+                          f"({_describe(err)})") from None
+    os.close(fd)
+    os.unlink(probe)
 
 
 def write_atomic(path: Path, data: str | bytes) -> None:
@@ -22,19 +105,100 @@ def write_with(path: Path, writer: Callable[[str], object]) -> None:
 
     The temporary keeps the target's extension (image writers choose the format by it).
     """
+    commit = prepare_with(path, writer)
+    commit()
+
+
+def prepare_with(path: Path, writer: Callable[[str], object]) -> Callable[[], None]:
+    """Write the temporary of `path` now; return the rename that puts it in place.
+
+    Several outputs that belong together (an image and its sidecar) are all prepared
+    first, then committed, so an interruption leaves none or all of them.
+    """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
-        raise InputError(f"cannot write {path}: directory {directory} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=directory)
+        raise OutputError(f"cannot write {path}: directory {directory} does not exist")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=directory)
+    except OSError as err:
+        raise OutputError(f"cannot write {path}: {_describe(err)}") from None
     os.close(fd)
     try:
         writer(tmp)
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; outputs are ordinary files
-        os.replace(tmp, path)
+    except OSError as err:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise OutputError(f"cannot write {path}: {_describe(err)}") from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+    def commit() -> None:
+        try:
+            os.replace(tmp, path)
+        except OSError as err:
+            _unlink(tmp)
+            raise OutputError(f"cannot write {path}: {_describe(err)}") from None
+        except BaseException:
+            _unlink(tmp)
+            raise
+
+    commit.discard = lambda: _unlink(tmp)  # type: ignore[attr-defined]
+    return commit
+
+
+def _unlink(path: str) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(path)
+
+
+@contextlib.contextmanager
+def staged_directory(out_dir: Path | str) -> Iterator[Path]:
+    """A temporary directory beside `out_dir` to write a run's many files into; when the
+    block ends normally its contents move into `out_dir` (created if missing), and when
+    it raises (an error, Ctrl-C, SIGTERM) it is removed: no partial run is left behind.
+    """
+    out_dir = Path(out_dir)
+    parent = out_dir.parent if str(out_dir.parent) else Path(".")
+    parent.mkdir(parents=True, exist_ok=True)
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=parent))
+    except OSError as err:
+        raise OutputError(f"cannot write {out_dir}: {_describe(err)}") from None
+    try:
+        try:
+            yield stage
+        except OutputError as err:  # name the file as the user will know it
+            err.message = err.message.replace(str(stage), str(out_dir))
+            err.args = (err.message,)
+            raise
+        if not out_dir.exists():
+            os.chmod(stage, 0o777 & ~_umask())
+            os.replace(stage, out_dir)
+            return
+        for source in sorted(stage.rglob("*")):
+            target = out_dir / source.relative_to(stage)
+            if source.is_dir():
+                target.mkdir(exist_ok=True)
+            else:
+                os.replace(source, target)
+    except OSError as err:
+        raise OutputError(f"cannot write {out_dir}: {_describe(err)}") from None
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def _umask() -> int:
+    umask = os.umask(0)
+    os.umask(umask)
+    return umask
+
+
+def describe_os_error(err: OSError) -> str:
+    """A short, lower-case reason for an OSError (used for standard output)."""
+    return _describe(err)

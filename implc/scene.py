@@ -82,6 +82,103 @@ class Shading:
 SHADING = Shading()
 
 
+# --------------------------------------------------------------------------- view checks
+#
+# A view that cannot show anything is refused with a reason and a fix rather than
+# rendered as a blank picture: the camera needs a direction (eye != target), an up hint
+# that is not parallel to it (right = forward x up would be zero: every ray is NaN), a
+# vertical field of view inside (0, 180) degrees, a clip sphere of positive radius, and
+# the clip sphere must be inside the view at least partly. `view_problems` checks what
+# holds for every image size (the sphere against the vertical field of view and the
+# plane of the eye); `frame_problem` adds the horizontal field of view of a W x H frame.
+# The sphere tests are plane tests (conservative: a sphere that grazes a frustum corner
+# passes), so only a view that certainly shows nothing is refused.
+
+PARALLEL_SINE = 1e-6  # |forward x up| / |up| below this: the up hint is parallel
+
+
+def view_problems(view: View) -> list[tuple[str, str]]:
+    """(key of [view], message with the fix) for each problem of `view`; empty when fine."""
+    problems: list[tuple[str, str]] = []
+    values = [*view.eye, *view.target, *view.up, *view.clip_center, view.fov_y_deg,
+              view.clip_radius]
+    if not all(math.isfinite(float(v)) for v in values):
+        return [("view", "every [view] value must be a finite number (no nan or inf)")]
+    if not 0.0 < view.fov_y_deg < 180.0:
+        problems.append(("fov", f"fov = {view.fov_y_deg:g} is outside (0, 180) degrees; "
+                                "a vertical field of view like fov = 30 shows the picture"))
+    if not view.clip_radius > 0.0:
+        problems.append(("radius", f"radius = {view.clip_radius:g}: the clip sphere needs a "
+                                   "positive radius, e.g. radius = 1.5"))
+    eye, target, up = (np.asarray(v, dtype=np.float64) for v in (view.eye, view.target, view.up))
+    distance = float(np.linalg.norm(target - eye))
+    if distance <= 1e-9 * max(1.0, float(np.abs(eye).max())):
+        problems.append(("target", f"eye and target are the same point {_vec(view.eye)}: the "
+                                   "camera has no direction; move `target` to what it "
+                                   "should look at (e.g. the clip sphere's centre)"))
+        return problems
+    forward = (target - eye) / distance
+    up_length = float(np.linalg.norm(up))
+    if up_length == 0.0:
+        problems.append(("up", f"up = {_vec(view.up)} has no direction; use "
+                               f"up = {_vec(suggest_up(forward))}"))
+    elif float(np.linalg.norm(np.cross(forward, up / up_length))) < PARALLEL_SINE:
+        problems.append(("up", f"up = {_vec(view.up)} is parallel to the view direction "
+                               f"(eye {_vec(view.eye)} to target {_vec(view.target)}), so "
+                               "the picture has no 'up'; choose an up perpendicular to "
+                               f"it, e.g. up = {_vec(suggest_up(forward))}"))
+    if problems:
+        return problems
+    outside = _sphere_outside(view, None)
+    if outside:
+        problems.append(("target", outside))
+    return problems
+
+
+def frame_problem(view: View, width: int, height: int) -> str | None:
+    """Why a `width` x `height` frame of `view` would be blank for certain, or None."""
+    problems = view_problems(view)
+    if problems:
+        return problems[0][1]
+    return _sphere_outside(view, width / height)
+
+
+def suggest_up(forward: np.ndarray) -> tuple[float, float, float]:
+    """The world axis least aligned with `forward` (positive direction): a usable up hint."""
+    axis = int(np.argmin(np.abs(forward)))
+    return tuple(1.0 if i == axis else 0.0 for i in range(3))  # type: ignore[return-value]
+
+
+def _sphere_outside(view: View, aspect: float | None) -> str | None:
+    """Where the clip sphere lies wholly outside the view (behind the eye, beyond one
+    side of the frustum), as a message with a fix; None when part of it may be seen.
+
+    aspect None: only what holds at every aspect ratio (behind, above, below)."""
+    forward, right, up = camera_basis(view)
+    offset = np.asarray(view.clip_center, dtype=np.float64) - np.asarray(view.eye)
+    radius = view.clip_radius
+    half_v = math.radians(view.fov_y_deg) / 2.0
+    planes = [("behind the camera", -forward),
+              ("above the picture", -math.sin(half_v) * forward + math.cos(half_v) * up),
+              ("below the picture", -math.sin(half_v) * forward - math.cos(half_v) * up)]
+    if aspect is not None:
+        half_h = math.atan(math.tan(half_v) * aspect)
+        planes += [("right of the picture",
+                    -math.sin(half_h) * forward + math.cos(half_h) * right),
+                   ("left of the picture",
+                    -math.sin(half_h) * forward - math.cos(half_h) * right)]
+    for where, normal in planes:
+        if float(np.dot(normal, offset)) > radius:
+            return (f"the clip sphere (centre {_vec(view.clip_center)}, radius {radius:g}) is "
+                    f"entirely {where}: the render would be blank; point `target` at it "
+                    f"(e.g. target = {_vec(view.clip_center)}), move `eye`, or widen `fov`")
+    return None
+
+
+def _vec(v) -> str:
+    return "[" + ", ".join(f"{float(x):g}" for x in v) + "]"
+
+
 def normalize(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     return v / np.where(n == 0.0, 1.0, n)

@@ -95,3 +95,33 @@ def browser():
             yield chromium
         finally:
             chromium.close()
+
+
+def check_golden(path, make_text, validate, update: bool, update_command: str) -> None:
+    """Compare a freshly emitted shader with its golden file, byte for byte.
+
+    Under --update-golden a file compared with what the test just wrote proves nothing,
+    so the update run checks what it is about to pin instead: the text must be accepted
+    by its language's real compiler (`validate(text)` returns a Verdict; an invalid
+    golden is never written), and a second, independent emission must give the same
+    bytes (deterministic output). Only a changed file is rewritten.
+    """
+    from pathlib import Path
+
+    path = Path(path)
+    text = make_text()
+    if update:
+        verdict = validate(text)
+        assert verdict.ok, (f"{path.name}: the new output fails validation; not written\n"
+                            + verdict.render(path.name))
+        again = make_text()
+        assert again == text, f"{path.name}: two emissions differ; not written"
+        if not path.exists() or path.read_text(encoding="utf-8") != text:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(text, encoding="utf-8")
+        return
+    assert path.exists(), f"missing golden {path}: run `{update_command}`"
+    assert text == path.read_text(encoding="utf-8"), (
+        f"{path.name} differs from its golden file; if the change is intended, run "
+        f"`{update_command}` and say why in the commit message"
+    )

@@ -168,3 +168,223 @@ def test_hostile_input_is_rejected_quickly(text, tmp_path):
     assert proc.returncode == 1, proc.stderr
     assert "error:" in proc.stderr and "Traceback" not in proc.stderr
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------- issue 13
+# Faults a new user met (each of these failed before its fix: a traceback, a silent
+# default, a blank picture or the wrong exit code).
+
+
+def _one_error_line(proc) -> str:
+    assert "Traceback" not in proc.stderr, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize(("output", "message"), [
+    ("/nonexistent/x.png", "implc: error: cannot write /nonexistent/x.png: directory "
+                           "/nonexistent does not exist"),
+    ("OUT/out.txt", "implc: error: cannot write OUT/out.txt: a render needs .png or .exr, "
+                    "not '.txt'"),
+    ("OUT/out", "implc: error: cannot write OUT/out: a render needs .png or .exr, "
+                "not no extension"),
+])
+def test_render_output_is_checked_before_rendering(tmp_path, output, message):
+    output = output.replace("OUT", str(tmp_path))
+    proc = implc("render", "cross-cap", "--size", "32", "-o", output)
+    assert proc.returncode == 1
+    assert _one_error_line(proc) == message.replace("OUT", str(tmp_path))
+    assert "rendered" not in proc.stderr  # refused before any work
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["compile", "sphere", "-o", "OUT/s.txt"],
+     "cannot write OUT/s.txt: a glsl shader needs .frag or .glsl, not '.txt'"),
+    (["compile", "sphere", "-t", "wgsl", "-o", "OUT/s.frag"],
+     "cannot write OUT/s.frag: a wgsl shader needs .wgsl, not '.frag'"),
+    (["compile", "sphere", "-o", "OUT/no/such/s.frag"],
+     "cannot write OUT/no/such/s.frag: directory OUT/no/such does not exist"),
+    (["corpus", "tests/data/corpus_permissive.tsv", "-o", "OUT/report.txt"],
+     "cannot write OUT/report.txt: the corpus report (Markdown) needs .md, not '.txt'"),
+    (["bench", "sphere", "-o", "OUT/file.txt/x"],
+     "cannot create OUT/file.txt/x: OUT/file.txt is not a directory"),
+])
+def test_every_output_option_is_checked_first(tmp_path, argv, message):
+    (tmp_path / "file.txt").write_text("a file\n")
+    proc = implc(*[a.replace("OUT", str(tmp_path)) for a in argv])
+    assert proc.returncode == 1
+    assert _one_error_line(proc) == "implc: error: " + message.replace("OUT", str(tmp_path))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file.txt"]
+
+
+@pytest.mark.parametrize(("size", "message"), [
+    (["--size", "0"], "image size must be between 1 and 8192 pixels (got 0)"),
+    (["--width", "0", "--height", "16"], "image size must be between 1 and 8192 pixels (got 0)"),
+    (["--size", "-3"], "image size must be between 1 and 8192 pixels (got -3)"),
+])
+def test_size_zero_is_an_error_not_the_default(tmp_path, size, message):
+    proc = implc("render", "sphere", *size, "-o", str(tmp_path / "a.png"))
+    assert proc.returncode == 1
+    assert _one_error_line(proc) == f"implc: error: {message}"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_width_alone_gives_a_square(tmp_path):
+    require_tool("glslangValidator")
+    from conftest import require_gl
+
+    require_gl()
+    proc = implc("render", "sphere", "--width", "24", "-o", str(tmp_path / "a.png"))
+    assert proc.returncode == 0, proc.stderr
+    assert "rendered 24x24" in proc.stderr
+
+
+SURFACE_FAULTS = [
+    # misspelled section and keys: errors with the line and a hint, not silent defaults
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[veiw]\neye = [1, 2, 3]\n',
+     "FILE:2:2: error: unknown section [veiw] in a surface file; did you mean [view]? "
+     "(known: name, equation, [params], [view])"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\nradus = 2\n',
+     "FILE:3:1: error: unknown key 'radus' in [view]; did you mean 'radius'? "
+     "(known: radius, center, eye, target, up, fov)"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\nradus = 2\n',
+     "FILE:2:1: error: unknown key 'radus' in a surface file; did you mean 'radius' "
+     "(under [view])? (known: name, equation, [params], [view])"),
+    ('equaton = "x^2 + y^2 + z^2 - 1"\n',
+     "FILE:1:1: error: unknown key 'equaton' in a surface file; did you mean 'equation'? "
+     "(known: name, equation, [params], [view])"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[parms]\na = 1\n',
+     "FILE:2:2: error: unknown section [parms] in a surface file; did you mean [params]? "
+     "(known: name, equation, [params], [view])"),
+    # a value's type: located at the value
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\nfov = "wide"\n',
+     "FILE:3:7: error: [view] fov must be a number, not a string"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [1, 2]\n',
+     "FILE:3:7: error: [view] eye must be 3 numbers, like [0.0, 0.0, 0.0]"),
+    ('equation = "x^2 + a"\n[params]\na = "big"\n',
+     "FILE:3:5: error: parameter 'a' must be a number, not a string"),
+    ('name = ["x"]\nequation = "x"\n', "FILE:1:8: error: name must be a string, not an array"),
+    # escapes before the fault: the column is the file's (it was the key's column + offset)
+    ('equation = "x^2 + \\t sinn(y)"\n',
+     "FILE:1:22: error: unknown function 'sinn'; did you mean 'sin'?"),
+    ('equation = "\\u0078^2 + sinn(y)"\n',
+     "FILE:1:24: error: unknown function 'sinn'; did you mean 'sin'?"),
+    ("equation = 'x^2 + sinn(y)'\n",
+     "FILE:1:19: error: unknown function 'sinn'; did you mean 'sin'?"),
+    # a multi-line string that starts with a newline (it was reported one line early)
+    ('equation = """\nx^2 +\n  sinn(y)"""\n',
+     "FILE:3:3: error: unknown function 'sinn'; did you mean 'sin'?"),
+    ('equation = """\\\n   x^2 + sinn(y)"""\n',
+     "FILE:2:10: error: unknown function 'sinn'; did you mean 'sin'?"),
+    ("equation = '''\nx^2 + sinn(y)'''\n",
+     "FILE:2:7: error: unknown function 'sinn'; did you mean 'sin'?"),
+    # degenerate cameras: an error with the fix, never a blank picture with exit 0
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [0, 3, 0]\n',
+     "FILE:3:7: error: [view] up = [0, 1, 0] is parallel to the view direction (eye "
+     "[0, 3, 0] to target [0, 0, 0]), so the picture has no 'up'; choose an up "
+     "perpendicular to it, e.g. up = [1, 0, 0]"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [1, 1, 1]\ntarget = [1, 1, 1]\n',
+     "FILE:4:10: error: [view] eye and target are the same point [1, 1, 1]: the camera has "
+     "no direction; move `target` to what it should look at (e.g. the clip sphere's "
+     "centre)"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\nup = [0, 0, 0]\n',
+     "FILE:3:6: error: [view] up = [0, 0, 0] has no direction; use up = [0, 1, 0]"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\nfov = 180\n',
+     "FILE:3:7: error: [view] fov = 180 must be between 0 and 180 (exclusive)"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\nfov = 0\n',
+     "FILE:3:7: error: [view] fov = 0 must be between 0 and 180 (exclusive)"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\ntarget = [0, 0, 10]\neye = [0, 0, 5]\n',
+     "FILE:3:10: error: [view] the clip sphere (centre [0, 0, 0], radius 1.5) is entirely "
+     "behind the camera: the render would be blank; point `target` at it (e.g. target = "
+     "[0, 0, 0]), move `eye`, or widen `fov`"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [0, 0, 5]\ntarget = [0, 5, 5]\n'
+     'up = [0, 0, 1]\n',
+     "FILE:4:10: error: [view] the clip sphere (centre [0, 0, 0], radius 1.5) is entirely "
+     "below the picture: the render would be blank; point `target` at it (e.g. target = "
+     "[0, 0, 0]), move `eye`, or widen `fov`"),
+    ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [nan, 0, 5]\n',
+     "FILE:3:7: error: [view] eye must be finite (no nan or inf)"),
+]
+
+
+@pytest.mark.parametrize(("content", "expected"), SURFACE_FAULTS)
+def test_surface_file_faults_are_located(tmp_path, content, expected):
+    surface = tmp_path / "s.toml"
+    surface.write_text(content, encoding="utf-8")
+    proc = implc("show", str(surface))
+    assert proc.returncode == 1, proc.stdout
+    assert "Traceback" not in proc.stderr
+    first = proc.stderr.splitlines()[0]
+    assert first == expected.replace("FILE", str(surface))
+    # the caret sits under the reported column of the quoted source line
+    _, line, col = first.split(": error:")[0].rsplit(":", 2)
+    shown = proc.stderr.splitlines()[1][2:]
+    caret = proc.stderr.splitlines()[2][2:]
+    assert shown == content.split("\n")[int(line) - 1]
+    assert caret.index("^") == int(col) - 1
+
+
+def test_a_frame_that_misses_the_clip_sphere_is_refused(tmp_path):
+    """Visible in a square frame's vertical field of view, but a 16 x 512 strip is too
+    narrow: the horizontal test needs the frame size (render time)."""
+    surface = tmp_path / "s.toml"
+    surface.write_text('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [0, 0, 8]\n'
+                       'target = [3, 0, 0]\nradius = 1\n')
+    proc = implc("render", str(surface), "--width", "16", "--height", "512",
+                 "-o", str(tmp_path / "a.png"))
+    assert proc.returncode == 1
+    line = _one_error_line(proc)
+    assert "entirely left of the picture" in line and "(16x512)" in line
+    assert not (tmp_path / "a.png").exists()
+
+
+def test_validate_missing_file_is_bad_input(tmp_path):
+    proc = implc("validate", str(tmp_path / "missing.frag"))
+    assert proc.returncode == 1
+    assert _one_error_line(proc) == f"implc: error: {tmp_path / 'missing.frag'}: no such file"
+    proc = implc("validate", str(tmp_path / "x.txt"))
+    assert proc.returncode == 1 and "unknown shader extension '.txt'" in proc.stderr
+
+
+CRASH = """
+import sys
+import implc.show
+def boom(*args, **kwargs):
+    raise ValueError("boom\\nsecond line")
+implc.show.describe = boom
+from implc.cli import main
+sys.exit(main(["show", "sphere"]))
+"""
+
+
+@pytest.mark.parametrize("debug", [False, True])
+def test_unexpected_exception_is_an_internal_error(debug):
+    """A bug (any exception implc did not expect) prints one line naming the command,
+    exits 70, and shows the traceback only with IMPLC_DEBUG=1."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env.pop("IMPLC_DEBUG", None)
+    if debug:
+        env["IMPLC_DEBUG"] = "1"
+    proc = subprocess.run([sys.executable, "-c", CRASH], capture_output=True, text=True,
+                          env=env, timeout=60)
+    assert proc.returncode == 70
+    last = proc.stderr.strip().splitlines()[-1]
+    assert last == ("implc: internal error in 'implc show': ValueError: boom (rerun with "
+                    "IMPLC_DEBUG=1 for the traceback, and please report it)")
+    assert ("Traceback" in proc.stderr) == debug
+    if not debug:
+        assert proc.stderr.strip() == last
+
+
+def test_exit_codes_are_documented():
+    """The README's exit-code table names every code the CLI can return."""
+    from implc import errors
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    table = readme[readme.index("### Exit codes"):]
+    table = table[: table.index("\n## ")]
+    for name in ("EXIT_OK", "EXIT_INPUT", "EXIT_USAGE", "EXIT_INVALID", "EXIT_TOOL",
+                 "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_TERMINATED"):
+        assert f"| {getattr(errors, name)} |" in table, name

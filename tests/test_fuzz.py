@@ -14,10 +14,12 @@ Properties, each under a per-case timer (a hang fails the case):
 1. the parser raises `InputError` (located, rendered without error) or returns a sympy
    expression in x, y, z and nothing else; its printed form (`Surface.equation`, the
    shader header) parses back to the same function;
-2. the whole path (parse -> derive -> optimize -> emit GLSL) gives a shader, or stops
-   with "too complex" (`--max-derived`); any other error means the parser accepted
-   something a later stage cannot handle (a printer meeting inf or a non-real constant);
-3. every shader of a random sample validates with glslangValidator.
+2. the whole path (parse -> derive -> optimize -> emit GLSL, WGSL and OpenCL C) gives a
+   shader for every target, or stops with "too complex" (`--max-derived`); any other
+   error means the parser accepted something a later stage cannot handle (a printer
+   meeting inf or a non-real constant);
+3. every shader of a random sample of each target validates with its real compiler
+   (glslangValidator, naga through wgpu, PoCL).
 
 `make test` runs a short derandomized pass (1,230 examples: ~4,000 parser and ~300
 whole-path cases counted, ~20 s); `make fuzz` sets IMPLC_FUZZ_SCALE (see the Makefile)
@@ -32,6 +34,7 @@ import os
 import random
 import re
 import signal
+import sys
 import time
 from collections import Counter
 from contextlib import contextmanager
@@ -302,41 +305,75 @@ def check_roundtrip(expr: sympy.Expr) -> None:
                                err_msg=f"{expr} printed as {text}")
 
 
-_SHADERS: list[str] = []  # a reservoir of emitted shaders, validated at the end of a test
+TARGET_NAMES = ("glsl", "wgsl", "opencl")
+# reservoirs of emitted shaders per target, validated by test_sampled_shaders_validate
+_SHADERS: dict[str, list[str]] = {target: [] for target in TARGET_NAMES}
+# shaders validated per target by one run of test_sampled_shaders_validate: PoCL builds
+# take ~0.5 s each, glslangValidator and naga a few ms
+SAMPLE = {"glsl": 25, "wgsl": 25, "opencl": 6}
 
 
-def check_path(expr: sympy.Expr, rng: random.Random) -> None:
-    """Property 2 (and a sample for property 3) on a parsed expression."""
+def check_path(expr: sympy.Expr, rng: random.Random, keep: float = 0.25) -> None:
+    """Property 2 (and a sample for property 3) on a parsed expression: the whole path
+    to every target's printer (GLSL, WGSL and OpenCL C); each shader is kept for
+    validation with probability `keep`."""
     from implc.derive import derive_limits
     from implc.emit import emit
     from implc.surface import Surface
 
     STATS["path"] += 1
     surface = Surface("fuzz", expr)
+    method = rng.choice(["hessian", "taylor", "curvature"])
+    texts = {}
     try:
         with time_limit(PATH_SECONDS, f"compiling {expr}"), derive_limits(PATH_MAX_DERIVED):
-            text = emit(surface, "glsl", rng.choice(["hessian", "taylor", "curvature"]))
+            for target in TARGET_NAMES:
+                texts[target] = emit(surface, target, method)
     except ImplcError as err:
         STATS["path rejected"] += 1
         assert str(err).startswith("too complex: "), err
         return
     STATS["path emitted"] += 1
-    if rng.random() < 0.25:
-        _SHADERS.append(text)
+    for target, text in texts.items():
+        STATS[f"emitted {target}"] += 1
+        if rng.random() < keep:
+            _SHADERS[target].append(text)
 
 
-def validate_sample(limit: int) -> None:
-    """Property 3: every sampled shader validates (glslangValidator), then empty the pool."""
+def _fill_pools(wanted: dict[str, int]) -> None:
+    """Top the pools up from the seeds (corpus rows, mutated), so the sample is never
+    empty: when this test runs alone, with -k, or before the whole-path tests."""
+    rng = random.Random(13)
+    attempts = 0
+    while any(len(_SHADERS[t]) < n for t, n in wanted.items()) and attempts < 2000:
+        attempts += 1
+        text = rng.choice(SEEDS)
+        expr = check_parse(text)
+        if expr is not None:
+            check_path(expr, rng, keep=1.0)
+
+
+def validate_sample(scale: float) -> Counter:
+    """Property 3: a sample of every target's shaders passes its real compiler
+    (glslangValidator, naga through wgpu, PoCL), then the pools are emptied."""
     from conftest import require_tool
 
-    from implc.validate import validate_glsl
+    from implc.validate import validate_text
 
     require_tool("glslangValidator")
-    pool, _SHADERS[:] = list(_SHADERS), []
-    for text in random.Random(len(pool)).sample(pool, min(limit, len(pool))):
-        verdict = validate_glsl(text, "fuzz.frag")
-        STATS["validated"] += 1
-        assert verdict.ok, f"{verdict.messages}\n--- shader header:\n{text[:600]}"
+    wanted = {t: examples(n, scale) for t, n in SAMPLE.items()}
+    _fill_pools(wanted)
+    validated: Counter = Counter()
+    for target in TARGET_NAMES:
+        pool, _SHADERS[target][:] = list(_SHADERS[target]), []
+        sample = random.Random(len(pool)).sample(pool, min(wanted[target], len(pool)))
+        for text in sample:
+            verdict = validate_text(text, target, f"fuzz.{target}")
+            STATS["validated"] += 1
+            STATS[f"validated {target}"] += 1
+            validated[target] += 1
+            assert verdict.ok, f"{verdict.messages}\n--- shader header:\n{text[:600]}"
+    return validated
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -346,8 +383,10 @@ def summary():
     elapsed = time.perf_counter() - start
     line = (f"fuzz: {STATS['parser']} parser cases ({STATS['parser accepted']} parsed, "
             f"{STATS['parser rejected']} rejected), {STATS['path']} whole-path cases "
-            f"({STATS['path emitted']} shaders, {STATS['path rejected']} over the bound), "
-            f"{STATS['validated']} validated; {STATS['parser'] + STATS['path']} cases in "
+            f"({STATS['path emitted']} x 3 targets emitted, {STATS['path rejected']} over "
+            f"the bound), {STATS['validated']} validated (glsl {STATS['validated glsl']}, "
+            f"wgsl {STATS['validated wgsl']}, opencl {STATS['validated opencl']}); "
+            f"{STATS['parser'] + STATS['path']} cases in "
             f"{elapsed:.0f} s")
     print("\n" + line)
     out = os.environ.get("IMPLC_FUZZ_SUMMARY")
@@ -355,21 +394,48 @@ def summary():
         Path(out).write_text(line + "\n", encoding="utf-8")
 
 
+_BAR = None  # make fuzz: a progress bar with an ETA per fuzz test (on a terminal)
+
+
+@pytest.fixture(autouse=True)
+def fuzz_progress(request):
+    """On a terminal under `make fuzz` (-s), a tqdm bar per test over its max_examples;
+    plain pytest output otherwise (the bar is off in the short pass)."""
+    global _BAR
+    chosen = getattr(request.function, "_hypothesis_internal_use_settings", None)
+    if LONG and chosen is not None:
+        from implc.progress import Progress
+
+        _BAR = Progress(chosen.max_examples, request.node.name, sys.stderr, unit="case")
+    yield
+    if _BAR is not None:
+        _BAR.close()
+        _BAR = None
+
+
+def tick() -> None:
+    if _BAR is not None:
+        _BAR.step()
+
+
 @profile(600)
 @given(EQUATIONS)
 def test_grammar_parser(text):
+    tick()
     check_parse(text)
 
 
 @profile(400)
 @given(mutants())
 def test_mutation_parser(text):
+    tick()
     check_parse(text)
 
 
 @profile(150, PATH_SCALE)
 @given(EQUATIONS, st.randoms(use_true_random=False))
 def test_grammar_whole_path(text, rng):
+    tick()
     expr = check_parse(text)
     assume(expr is not None)
     check_path(expr, rng)
@@ -378,14 +444,23 @@ def test_grammar_whole_path(text, rng):
 @profile(80, PATH_SCALE)
 @given(mutants(), st.randoms(use_true_random=False))
 def test_mutation_whole_path(text, rng):
+    tick()
     expr = check_parse(text)
     assume(expr is not None)
     check_path(expr, rng)
 
 
 def test_sampled_shaders_validate():
-    """Runs after the whole-path tests (file order) on the shaders they kept."""
-    validate_sample(examples(25, PATH_SCALE))
+    """Validates the shaders the whole-path tests kept (they run first in file order) and,
+    when there are too few (run alone, with -k, in another order), shaders it makes from
+    the seeds: every target's full sample is validated, whatever ran before."""
+    from test_opencl import require_opencl
+    from test_wgsl import require_wgpu
+
+    require_wgpu()
+    require_opencl()
+    validated = validate_sample(PATH_SCALE)
+    assert validated == Counter({t: examples(n, PATH_SCALE) for t, n in SAMPLE.items()})
 
 
 # --------------------------------------------------------------------------- findings

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 from cases import golden_cases, golden_name
-from conftest import require_tool
+from conftest import check_golden, require_tool
 
 from implc.emit import emit
 from implc.surface import load_surface
@@ -24,17 +24,10 @@ def _emit(example: str, method: str, flavor: str, kind: str) -> str:
 @pytest.mark.parametrize("case", golden_cases(), ids=lambda c: golden_name(*c))
 def test_golden(case, update_golden):
     name = golden_name(*case)
-    text = _emit(*case)
-    path = GOLDEN / name
     if update_golden:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-    assert path.exists(), f"missing golden {path}: run `pytest --update-golden` (make golden)"
-    expected = path.read_text(encoding="utf-8")
-    assert text == expected, (
-        f"{name} differs from its golden file; if the change is intended, run "
-        "`pytest --update-golden` (or `make golden`) and say why in the commit message"
-    )
+        require_tool("glslangValidator")
+    check_golden(GOLDEN / name, lambda: _emit(*case), lambda text: validate_glsl(text, name),
+                 update_golden, "pytest --update-golden` (or `make golden")
 
 
 @pytest.mark.parametrize("case", golden_cases(), ids=lambda c: golden_name(*c))

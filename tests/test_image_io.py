@@ -8,6 +8,7 @@ import numpy as np
 import OpenImageIO as oiio
 import pytest
 
+from implc.errors import OutputError
 from implc.render.image_io import EXR_CHANNELS, read_render, write_render
 from implc.render.result import RenderResult
 
@@ -83,16 +84,16 @@ def test_writes_leave_no_temp_files(tmp_path):
 def test_failed_write_leaves_nothing(tmp_path):
     with pytest.raises(TypeError):
         write_render(make_render(), tmp_path / "bad.exr", {"x": object()})
-    with pytest.raises(ValueError, match="unknown image type"):
+    with pytest.raises(OutputError, match=r"needs \.png or \.exr, not '\.tiff'"):
         write_render(make_render(), tmp_path / "bad.tiff", METADATA)
-    with pytest.raises(OSError):
+    with pytest.raises(OutputError, match="does not exist"):
         write_render(make_render(), tmp_path / "missing" / "bad.exr", METADATA)
     assert list(tmp_path.iterdir()) == []
 
 
 def test_failed_move_removes_the_written_temp_file(tmp_path):
     (tmp_path / "taken.exr").mkdir()  # os.replace of the finished temp file onto it fails
-    with pytest.raises(OSError):
+    with pytest.raises(OutputError, match="is a directory"):
         write_render(make_render(), tmp_path / "taken.exr", METADATA)
     assert [p.name for p in tmp_path.iterdir()] == ["taken.exr"]
     assert list((tmp_path / "taken.exr").iterdir()) == []

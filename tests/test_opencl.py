@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import sympy
 from cases import METHOD_NAMES, PAPER, opencl_golden_cases, opencl_golden_name
-from conftest import IN_CI, require_gl
+from conftest import IN_CI, check_golden, require_gl
 from test_cli import implc
 
 from implc import devices
@@ -57,16 +57,15 @@ IDS = [opencl_golden_name(*c) for c in CASES]
 @pytest.mark.parametrize("case", CASES, ids=IDS)
 def test_golden(case, update_golden):
     name = opencl_golden_name(*case)
-    text = _emit(*case)
-    path = GOLDEN / name
     if update_golden:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-    assert path.exists(), f"missing golden {path}: run `{UPDATE}`"
-    assert text == path.read_text(encoding="utf-8"), (
-        f"{name} differs from its golden file; if the change is intended, run "
-        f"`{UPDATE}` and say why in the commit message"
-    )
+        require_opencl()
+
+    def build(text: str):
+        if "cl_khr_fp64" in text and not devices.opencl_device().has_fp64:
+            pytest.skip("this OpenCL device has no cl_khr_fp64")
+        return validate_opencl(text, name)
+
+    check_golden(GOLDEN / name, lambda: _emit(*case), build, update_golden, UPDATE)
 
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)

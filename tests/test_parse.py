@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import json
 import random
@@ -337,17 +336,26 @@ def test_limit_message_names_the_limit_and_its_value() -> None:
 
 
 @pytest.mark.parametrize(
-    ("text", "limits"),
+    ("text", "limits", "expected"),
     [
-        ("(x+y+z)^30 (x+y+z)^30", {"max_degree": 60}),
-        ("x^100", {"max_exponent": 100, "max_degree": 100}),
-        ("x - 2^1000", {"max_constant_digits": 400}),
-        ("x - 1e40", {"max_literal_exponent": 40}),
-        ("(" * 300 + "x" + ")" * 300, {"max_depth": 400}),
+        ("(x+y+z)^30 (x+y+z)^30", {"max_degree": 60}, (X + Y + Z) ** 60),
+        ("x^100", {"max_exponent": 100, "max_degree": 100}, X**100),
+        ("x - 2^1000", {"max_constant_digits": 400}, X - sympy.Integer(2) ** 1000),
+        ("x - 1e40", {"max_literal_exponent": 40}, X - sympy.Integer(10) ** 40),
+        ("x - 1e-40", {"max_literal_exponent": 40}, X - sympy.Rational(1, 10**40)),
+        ("(" * 300 + "x" + ")" * 300, {"max_depth": 400}, X),
     ],
 )
-def test_raised_limits_accept_the_input(text: str, limits: dict[str, int]) -> None:
-    parse(text, **limits)
+def test_raised_limits_accept_the_input(text: str, limits: dict[str, int],
+                                        expected: sympy.Expr) -> None:
+    """Raising a limit accepts the input and reads it exactly as it would without the
+    limit: compared by exact evaluation at rational points (no expansion of degree 60)."""
+    got = parse(text, **limits)
+    assert got.free_symbols <= {X, Y, Z}
+    for point in ((sympy.Rational(1, 3), sympy.Rational(-2, 7), sympy.Rational(5, 4)),
+                  (sympy.Rational(7, 5), sympy.Rational(1, 2), sympy.Rational(-3, 11))):
+        at = dict(zip((X, Y, Z), point, strict=True))
+        assert got.subs(at) == expected.subs(at), (text, got)
 
 
 def test_within_the_default_limits() -> None:
@@ -405,6 +413,14 @@ def test_random_strings_are_numbers_or_rejected() -> None:
 
 
 def test_random_token_soup_is_parsed_or_rejected() -> None:
+    """2000 random token strings: each parses to an expression in x, y, z alone (the
+    parameter substituted, no unknown function) whose printed form parses back to the
+    same function, or is rejected with an InputError located inside the text. Both
+    outcomes must occur, so neither branch is checked vacuously."""
+    from implc.functions import BY_SYMPY_NAME
+    from implc.numeric import evaluate
+    from implc.textform import to_text
+
     rng = random.Random(7)
     pieces = [
         "x", "y", "z", "xy", "2", "0", "0.5", "1e3", "1e-40", "pi", "e", "a", "(", ")",
@@ -412,10 +428,31 @@ def test_random_token_soup_is_parsed_or_rejected() -> None:
         "cbrt(", "sqrt(", "(1/3)", "foo", "9^9",
     ]  # fmt: skip
     params = {"a": sympy.Rational(1, 2)}
+    points = {X: 0.3, Y: -0.45, Z: 0.7}
+    parsed = rejected = 0
     for _ in range(2000):
         text = "".join(rng.choice(pieces) for _ in range(rng.randint(1, 12)))
-        with contextlib.suppress(InputError):
-            parse_equation(Source("<fuzz>", text), params)
+        try:
+            expr = parse_equation(Source("<fuzz>", text), params)
+        except InputError as err:
+            rejected += 1
+            rendered = err.render()
+            assert rendered.startswith("<fuzz>:1:"), rendered
+            col = int(rendered.split(":")[2])
+            assert 1 <= col <= len(text) + 1, (text, rendered)
+            continue
+        parsed += 1
+        assert isinstance(expr, sympy.Expr), text
+        assert expr.free_symbols and expr.free_symbols <= {X, Y, Z}, (text, expr)
+        names = {type(f).__name__ for f in expr.atoms(sympy.Function)}
+        assert names <= set(BY_SYMPY_NAME), (text, expr)
+        again = parse_equation(Source("<printed>", to_text(expr)), limits=Limits(
+            max_literal_exponent=330, max_constant_digits=3000, max_degree=10**4,
+            max_exponent=10**4, max_terms=10**12))
+        a, b = float(evaluate(expr, points)), float(evaluate(again, points))
+        assert (a == b) or (abs(a - b) <= 1e-9 * (1 + abs(a))) or (a != a and b != b), (
+            text, expr, to_text(expr))
+    assert parsed >= 25 and rejected >= 1000, (parsed, rejected)  # 33 and 1967 (seed 7)
 
 
 @pytest.mark.skipif(not CORPUS.exists(), reason="../shared/corpus is not present")

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import sympy
 from cases import PAPER, wgsl_golden_cases, wgsl_golden_name
-from conftest import IN_CI, require_gl
+from conftest import IN_CI, check_golden, require_gl
 from test_cli import implc
 
 from implc.backends.wgsl import RESERVED_WORDS, WgslPrinter
@@ -61,16 +61,8 @@ def _emit(example: str, method: str, taylor2: str, kind: str) -> str:
 @pytest.mark.parametrize("case", CASES, ids=lambda c: wgsl_golden_name(*c))
 def test_golden(case, update_golden):
     name = wgsl_golden_name(*case)
-    text = _emit(*case)
-    path = GOLDEN / name
-    if update_golden:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-    assert path.exists(), f"missing golden {path}: run `pytest --update-golden` (make golden)"
-    assert text == path.read_text(encoding="utf-8"), (
-        f"{name} differs from its golden file; if the change is intended, run "
-        "`pytest --update-golden` (or `make golden`) and say why in the commit message"
-    )
+    check_golden(GOLDEN / name, lambda: _emit(*case), lambda text: validate(text, name),
+                 update_golden, "pytest --update-golden` (or `make golden")
 
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: wgsl_golden_name(*c))

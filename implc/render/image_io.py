@@ -4,20 +4,20 @@ The EXR holds float32 channels exactly `R G B A Z steps`: colour, A = hit (0/1),
 along the unit ray direction from the eye (0 where no hit), and march steps. The JSON
 beside it (`<stem>.json`) carries what is needed to recompute every pixel's ray (camera,
 surface, method, parameters, timings). Every file is written atomically: a temp file in
-the same directory, then os.replace, so a reader never sees a partial file.
+the same directory, then os.replace, so a reader never sees a partial file
+(implc.fileio).
 """
 
 from __future__ import annotations
 
 import json
-import os
-import secrets
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import OpenImageIO as oiio
 
+from ..errors import OutputError
+from ..fileio import prepare_with
 from .result import RenderResult
 
 EXR_CHANNELS = ("R", "G", "B", "A", "Z", "steps")
@@ -33,12 +33,25 @@ def write_render(result: RenderResult, path: Path, metadata: dict) -> list[Path]
     text = json.dumps(metadata, indent=2, sort_keys=True, default=_json_value) + "\n"
     suffix = path.suffix.lower()
     if suffix == ".png":
-        _atomic(path, lambda tmp: _write_png(result, tmp))
+        write = _write_png
     elif suffix == ".exr":
-        _atomic(path, lambda tmp: _write_exr(result, tmp))
+        write = _write_exr
     else:
-        raise ValueError(f"{path}: unknown image type {path.suffix!r} (use .png or .exr)")
-    _atomic(sidecar, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+        raise OutputError(f"cannot write {path}: a render needs .png or .exr, not "
+                          f"'{path.suffix}'")
+    # both temporaries first, then both renames: an interruption leaves neither or both
+    image = prepare_with(path, lambda tmp: write(result, tmp))
+    try:
+        side = prepare_with(sidecar, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    except BaseException:
+        image.discard()
+        raise
+    try:
+        image()
+    except BaseException:
+        side.discard()
+        raise
+    side()
     return [path, sidecar]
 
 
@@ -102,22 +115,6 @@ def _write_image(path: Path, spec: oiio.ImageSpec, pixels: np.ndarray) -> None:
             raise OSError(f"{path}: {out.geterror()}")
     finally:
         out.close()
-
-
-def _atomic(path: Path, write: Callable[[Path], object]) -> None:
-    """Run `write` on a temp file beside `path` (same suffix, so OIIO picks the format),
-    then move it into place; the temp file is removed if anything fails.
-
-    The temp name is random rather than from mkstemp, so the file gets the umask's usual
-    permissions instead of mkstemp's 0600.
-    """
-    tmp = path.with_name(f".{path.stem}.{secrets.token_hex(6)}.tmp{path.suffix}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def _json_value(value: object) -> object:

@@ -1,0 +1,173 @@
+"""Metamorphic render tests (in the spirit of GraphicsFuzz): two inputs whose pictures
+must agree by construction, rendered on every target (GL, wgpu, OpenCL float) at 48².
+
+Which relations are exact, and why:
+
+- S and -S (sign, taylor, hessian, hessian-approx): each step rule and root test depends
+  only on |F|, |F'| and whether 0 lies in an interval whose ends all change sign, and the
+  refinement's Newton step F/F' is unchanged. Where the -S program is the term-by-term
+  negation of the S program (the Cross-Cap: CSE picks the same temporaries, and float
+  negation is exact) every value changes sign exactly, so hit mask and t agree bit for
+  bit. Where CSE picks other temporaries for -S (the Steiner surface's gradient: 2x, 2y,
+  2z instead of 2y and yz) F' rounds differently: t within T_TOL, masks within
+  EDGE_PIXELS boundary pixels (measured: identical masks, t within 1 ulp).
+  The *colour* is not compared: the front/back side is chosen by the sign of grad(S).D.
+  Not `curvature`: its step is b/2 where -ΔS < 0 and 2b elsewhere, and -ΔS changes sign
+  with S, so -S marches with other steps (measured: 8 of 2304 pixels differ at 48²).
+- S and c·S, c > 0: the root tests (sign of a product, 0 in an interval) and the
+  curvature rule (sign of -ΔS) are scale-free, but Eq. 2 compares |F| with tau1, tau2 and
+  |F'| with tau3, so c·S takes other steps unless the thresholds are scaled by c too:
+  compared with tau_i -> c·tau_i (curvature has no tau). Exact in real arithmetic; in
+  float32, sympy distributes c over the sum (c·S is not printed as c*(S)), which rounds
+  differently, so a ray that grazes the surface may decide otherwise: the masks may
+  differ on boundary pixels only (a pixel with a differently-hit 4-neighbour), at most
+  EDGE_PIXELS of them, and t within T_TOL where both hit. Measured: 0 pixels differ.
+- A surface and its rotated or translated copy, with the camera (eye, target, up, clip
+  centre) moved alike: the same rays relative to the surface, so the same picture, up to
+  float rounding of the moved coordinates (the lights are fixed to the camera, so the
+  shading moves with it): hit masks within EDGE_PIXELS boundary pixels, colour within
+  COLOR_TOL where both hit. The rotation is a cyclic permutation of the axes and the
+  translation dyadic, so the moved camera is exact. Measured: 0 pixels, |dcolour| < 2e-5.
+- `+ 0*x^3` and `x^2y^2` rewritten as `(x*y)^2`: the parser builds the same expression,
+  so the shader is byte-identical and no pixel may change (bit-exact).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy
+from conftest import require_gl
+
+from implc.methods import METHODS
+from implc.render.run import render
+from implc.scene import View
+from implc.surface import Surface, load_surface
+from implc.symbols import X, Y, Z
+
+SIZE = 48
+EDGE_PIXELS = 4  # of 2304: a few grazing rays, only on the mask's boundary
+T_TOL = 1e-4
+COLOR_TOL = 2e-3
+BACKENDS = ("gl", "wgpu", "cl")
+SURFACES = ("cross-cap", "steiner")
+EXACT_NEGATION = {"cross-cap"}  # its -S program is the S program with every sign flipped
+
+
+def require_backend(backend: str) -> None:
+    if backend == "gl":
+        require_gl()
+    elif backend == "wgpu":
+        from test_wgsl import require_wgpu
+
+        require_wgpu()
+    else:
+        from test_opencl import require_opencl
+
+        require_opencl()
+
+
+def frame(surface: Surface, backend: str, method: str, **constants):
+    return render(surface, backend, method, METHODS[method].constants(**constants), SIZE, SIZE)
+
+
+def boundary(hit: np.ndarray) -> np.ndarray:
+    """Pixels with a 4-neighbour of the other hit value."""
+    edge = np.zeros_like(hit)
+    edge[1:, :] |= hit[1:, :] != hit[:-1, :]
+    edge[:-1, :] |= hit[:-1, :] != hit[1:, :]
+    edge[:, 1:] |= hit[:, 1:] != hit[:, :-1]
+    edge[:, :-1] |= hit[:, :-1] != hit[:, 1:]
+    return edge
+
+
+def assert_masks_close(a, b, what: str) -> None:
+    differ = a.hit != b.hit
+    assert a.hit.sum() > 0.1 * a.hit.size, f"{what}: the surface is hardly in the picture"
+    off_edge = differ & ~(boundary(a.hit) | boundary(b.hit))
+    assert not off_edge.any(), f"{what}: {off_edge.sum()} pixels differ inside the mask"
+    assert differ.sum() <= EDGE_PIXELS, f"{what}: {differ.sum()} boundary pixels differ"
+    both = a.hit & b.hit
+    assert np.abs(a.t - b.t)[both].max(initial=0.0) <= T_TOL, f"{what}: t differs"
+
+
+def moved(surface: Surface, move, expr: sympy.Expr, turn=lambda v: v) -> Surface:
+    v = surface.view
+    view = View(eye=move(v.eye), target=move(v.target), up=turn(v.up), fov_y_deg=v.fov_y_deg,
+                clip_center=move(v.clip_center), clip_radius=v.clip_radius)
+    return Surface(surface.name + " moved", expr, surface.params, view)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("example", SURFACES)
+@pytest.mark.parametrize("method", ["sign", "taylor", "hessian", "hessian-approx"])
+def test_negated_surface_has_the_same_hits(backend, example, method):
+    require_backend(backend)
+    s = load_surface(example)
+    a = frame(s, backend, method)
+    b = frame(Surface(s.name, -s.expr, s.params, s.view), backend, method)
+    assert_masks_close(a, b, f"-S, {example}, {method}, {backend}")
+    if example in EXACT_NEGATION:
+        assert np.array_equal(a.hit, b.hit), f"{(a.hit != b.hit).sum()} pixels differ"
+        assert np.array_equal(a.t[a.hit], b.t[b.hit])
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("c", [4, sympy.Rational(3, 10)], ids=["4", "0.3"])
+@pytest.mark.parametrize("method", ["sign", "hessian", "curvature"])
+def test_scaled_surface_has_the_same_hits(backend, c, method):
+    require_backend(backend)
+    s = load_surface("cross-cap")
+    d = METHODS[method].defaults
+    scaled = {} if method == "curvature" else {
+        "tau1": d.tau1 * float(c), "tau2": d.tau2 * float(c), "tau3": d.tau3 * float(c)}
+    a = frame(s, backend, method)
+    b = frame(Surface(s.name, c * s.expr, s.params, s.view), backend, method, **scaled)
+    assert_masks_close(a, b, f"{c}·S, {method}, {backend}")
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("example", SURFACES)
+def test_rotated_and_translated_copies_look_the_same(backend, example):
+    require_backend(backend)
+    s = load_surface(example)
+    a = frame(s, backend, "hessian")
+
+    def turn(p):  # rotation R(x, y, z) = (z, x, y): 120 degrees about (1, 1, 1)
+        return (p[2], p[0], p[1])
+
+    rotated = moved(s, turn, s.expr.xreplace({X: Y, Y: Z, Z: X}), turn)  # S(R^-1 p)
+    shift = (0.25, -0.5, 0.125)
+
+    def move(p):
+        return tuple(float(a_ + b_) for a_, b_ in zip(p, shift, strict=True))
+
+    back = {X: X - sympy.Rational(1, 4), Y: Y + sympy.Rational(1, 2), Z: Z - sympy.Rational(1, 8)}
+    translated = moved(s, move, s.expr.xreplace(back))
+    for copy, what in ((rotated, "rotated"), (translated, "translated")):
+        b = frame(copy, backend, "hessian")
+        assert_masks_close(a, b, f"{what} {example} on {backend}")
+        both = a.hit & b.hit
+        assert np.abs(a.color - b.color)[both].max() <= COLOR_TOL, f"{what}: colour differs"
+
+
+REWRITES = [
+    ("x^2y^2 + y^2z^2 + z^2x^2 - xyz", "x^2y^2 + y^2z^2 + z^2x^2 - xyz + 0*x^3"),
+    ("x^2y^2 + y^2z^2 + z^2x^2 - xyz", "(x*y)^2 + (y*z)^2 + (z*x)^2 - xyz"),
+    ("4x^2(x^2 + y^2 + z^2 + z) + y^2(y^2 + z^2 - 1)",
+     "4x^2(x^2 + y^2 + z^2 + z) + y^2(y^2 + z^2 - 1) + 0*x^3 - 0*(x*y)^2"),
+]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize(("text", "rewritten"), REWRITES)
+def test_rewrites_change_no_pixel(backend, text, rewritten):
+    require_backend(backend)
+    view = load_surface("cross-cap").view
+    a_surface = load_surface(equation=text)
+    b_surface = load_surface(equation=rewritten)
+    a = frame(Surface("a", a_surface.expr, view=view), backend, "hessian")
+    b = frame(Surface("b", b_surface.expr, view=view), backend, "hessian")
+    assert a.hit.sum() > 0.05 * a.hit.size
+    assert np.array_equal(a.hit, b.hit) and np.array_equal(a.color, b.color)
+    assert np.array_equal(a.t, b.t) and np.array_equal(a.steps, b.steps)
