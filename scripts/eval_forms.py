@@ -39,7 +39,9 @@ def sweep_equations(degree: int) -> dict[str, str]:
     return {"powers": f"x^{degree} + y^{degree} + z^{degree} - 1", "chmutov": cheb}
 
 
-def measure(surface, methods: list[str], size: int, frames: int) -> dict:
+def measure(surface, methods: list[str], size: int, frames: int, exact: bool = False) -> dict:
+    """Per (method, form): median ms and the metrics against the reference; with `exact`
+    also ("exact", "ray-poly"), timed in the same rounds."""
     reference = open_runner(surface, "reference", "", get_method("taylor").defaults,
                             size, size).frame()
     keys, runners = [], []
@@ -49,6 +51,10 @@ def measure(surface, methods: list[str], size: int, frames: int) -> dict:
                 constants = get_method(method).constants(evaluation=form)
                 runners.append(open_runner(surface, "gl", method, constants, size, size))
                 keys.append((method, form))
+        if exact:
+            runners.append(open_runner(surface, "gl", "exact", get_method("exact").defaults,
+                                       size, size))
+            keys.append(("exact", "ray-poly"))
         seconds, last = time_interleaved(runners, frames)
     finally:
         for r in runners:
@@ -83,21 +89,23 @@ def accuracy(names: list[str], methods: list[str], size: int, frames: int) -> No
 
 def sweep(degrees: list[int], method: str, size: int, frames: int, plot: str | None) -> None:
     rows = []
-    print(f"| family | degree | {' | '.join(f'{f} ms' for f in FORMS)} | "
-          f"{' | '.join(f'{f} compile s' for f in FORMS)} | "
-          f"{' | '.join(f'{f} false / missed / wrong' for f in FORMS)} |")
-    print("|---|---|" + "---|" * (3 * len(FORMS)))
+    print(f"| family | degree | {' | '.join(f'{method} {f} ms' for f in FORMS)} | exact ms | "
+          f"{' | '.join(f'{f} compile s' for f in FORMS)} | exact compile s | "
+          f"{' | '.join(f'{f} false / missed / wrong' for f in FORMS)} | "
+          "exact false / missed / wrong |")
+    print("|---|---|" + "---|" * (3 * len(FORMS) + 3))
     for degree in degrees:
         for family, equation in sweep_equations(degree).items():
             surface = load_surface(equation=equation)
-            results = measure(surface, [method], size, frames)
+            results = measure(surface, [method], size, frames, exact=True)
             compile_s = {f: compile_seconds(["-e", equation, "-m", method, "--eval", f])
                          for f in FORMS}
-            cells = [results[method, f] for f in FORMS]
+            compile_s["exact"] = compile_seconds(["-e", equation, "-m", "exact"])
+            cells = [results[method, f] for f in FORMS] + [results["exact", "ray-poly"]]
             rows.append((family, degree, cells, compile_s))
             print(f"| {family} | {degree} | "
                   + " | ".join(f"{c['ms']:.1f}" for c in cells) + " | "
-                  + " | ".join(f"{compile_s[f]:.2f}" for f in FORMS) + " | "
+                  + " | ".join(f"{compile_s[f]:.2f}" for f in (*FORMS, "exact")) + " | "
                   + " | ".join(f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
                                for c in cells) + " |", flush=True)
     if plot:
@@ -114,13 +122,14 @@ def _plot(rows, method: str, size: int, path: str) -> None:
     for family, style in (("powers", "-"), ("chmutov", "--")):
         data = [r for r in rows if r[0] == family]
         degrees = [r[1] for r in data]
-        for k, form in enumerate(FORMS):
-            color = ("tab:blue", "tab:orange")[k]
+        for k, form in enumerate((*FORMS, "exact")):
+            color = ("tab:blue", "tab:orange", "tab:green")[k]
+            label = f"{method} {form}" if form != "exact" else "exact"
             axes[0].plot(degrees, [r[2][k]["ms"] for r in data], style, marker="o",
-                         color=color, label=f"{form}, {family}")
+                         color=color, label=f"{label}, {family}")
             axes[1].plot(degrees, [r[3][form] for r in data], style, marker="o",
-                         color=color, label=f"{form}, {family}")
-    axes[0].set_title(f"frame time, {method}, {size}x{size}, llvmpipe")
+                         color=color, label=f"{label}, {family}")
+    axes[0].set_title(f"frame time, {size}x{size}, llvmpipe")
     axes[0].set_ylabel("ms per frame (median)")
     axes[1].set_title("compile time (cold `implc compile`)")
     axes[1].set_ylabel("seconds")
