@@ -456,6 +456,13 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     # F itself, whose sign is the answer: Horner where that sign is certain, else at the
     # point (ray_F; see RAY_DERIVATIVES)
     functions.append(_value_function(n, printer, prefix))
+    scale: sympy.Expr = sympy.S.Zero
+    for k in range(n, -1, -1):
+        scale = scale * sympy.Abs(u) + sympy.Abs(c[k])
+    functions.append(ShaderFunction(
+        "scale_at", "sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit "
+        "(the reference's own: 1e-12 sum |a_k| s^k)", (("Ray", "ray"), ("real", "u")), "real",
+        (), (printer.doprint(scale),)))
     functions.append(ShaderFunction(
         f"P{n}", f"P{n} = F (ray_F)", (("Ray", "ray"), ("real", "u")), "real", (),
         (f"{prefix}ray_F(ray, u)",)))

@@ -57,20 +57,24 @@ class Constants:
     refine_steps: int = 10  # Newton-bisection iterations on the isolated interval
     # how the ray quantities are computed: "point", "ray-poly" or "auto" (implc/marcher.py)
     evaluation: str = "auto"
-    # exact: |F| <= touch * sum |c_k| r^k at a critical point is a touching root (r: half
-    # the chord), the relative tolerance of the float64 reference's own touch test, so a
-    # touch is reported only where the reference would report one (1e-9 measured 1-2
-    # false-hit pixels at 512^2 near the double lines of the Cross-Cap, Miter and Roman
-    # surfaces, 1e-8 8-16); Newton stops when its step is below xtol (times 1 + |u|) or
-    # after newton_steps iterations (README "The exact method")
-    touch: float = 1e-12
+    # exact: |F| <= touch * sum |c_k| |u|^k at a critical point u is a touching root, an
+    # order below the float64 reference's own relative tolerance (1e-12 sum |a_k| s^k, its
+    # terms taken from the entry point, ours from the chord's middle): at 1e-12 one Miter
+    # pixel at 1024^2, a ray passing 1e-6 from the z-axis where S >= 0 touches zero
+    # (F's minimum 9e-13), counted as a touch that the reference rejects; 1e-9 and 1e-8
+    # measured 1-2 and 8-16 false hits at 512^2 next to double lines. Newton stops when
+    # its step is below xtol (times 1 + |u|) or after newton_steps iterations (README
+    # "The exact method")
+    touch: float = 1e-13
     xtol: float = 1e-6
     # the same for the critical points (roots of F', F'', ...), which only split the ray
     # into monotonic pieces: placing one off by delta can hide only a pair of roots closer
     # than delta, a dip of F smaller than |F''| delta^2 / 8 (1e-8 |F''| at 3e-4), below
     # float32's resolution of F
     ctol: float = 3e-4
-    newton_steps: int = 16
+    # 12: the tail of slow lanes is cut and every degree up to 12 compiles (llvmpipe's
+    # LLVM took minutes on a degree-10 solver at 15 and more)
+    newton_steps: int = 12
 
     def as_dict(self) -> dict:
         return asdict(self)

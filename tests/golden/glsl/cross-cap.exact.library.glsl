@@ -16,11 +16,11 @@
 // rd must be unit length; t is measured along rd from ro.
 
 // Method constants (implc compile options).
-const float CROSS_CAP_TOUCH = 1e-12;
+const float CROSS_CAP_TOUCH = 1e-13;
 const float CROSS_CAP_HORNER_ERR = 9.5367431640625e-07;
 const float CROSS_CAP_XTOL = 1e-06;
 const float CROSS_CAP_CTOL = 0.0003;
-const int CROSS_CAP_NEWTON_STEPS = 16;
+const int CROSS_CAP_NEWTON_STEPS = 12;
 
 struct cross_cap_Ray {
     vec3 o;  // origin of the march, s = 0
@@ -86,6 +86,11 @@ float cross_cap_P3(cross_cap_Ray ray, float u) {
 float cross_cap_ray_F(cross_cap_Ray ray, float u) {
     float h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return (abs(h) > CROSS_CAP_HORNER_ERR*ray.size ? h : cross_cap_S(ray.o + (u + ray.sm)*ray.d));
+}
+
+// sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
+float cross_cap_scale_at(cross_cap_Ray ray, float u) {
+    return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
 }
 
 // P4 = F (ray_F)
@@ -155,11 +160,13 @@ float cross_cap_root3(cross_cap_Ray ray, float a0, float b0) {
             a = x;
             fa = f;
         }
-        float next = x - f/d;
+        float step = f/d;
+        float next = x - step;
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        if (abs(next - x) <= CROSS_CAP_CTOL*(1.0 + abs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (abs(step) <= CROSS_CAP_CTOL*(1.0 + abs(x))) {
             x = next;
             break;
         }
@@ -187,11 +194,16 @@ float cross_cap_root4(cross_cap_Ray ray, float a0, float b0) {
             a = x;
             fa = f;
         }
-        float next = x - f/d;
+        float step = f/d;
+        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
+        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
+        float lh = step*cross_cap_P2(ray, x)/d;
+        float next = (abs(lh) < 1.0 ? x - step/(1.0 - 0.5*lh) : x - step);
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        if (abs(next - x) <= CROSS_CAP_XTOL*(1.0 + abs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (abs(step) <= CROSS_CAP_XTOL*(1.0 + abs(x))) {
             x = next;
             break;
         }
@@ -232,7 +244,6 @@ cross_cap_Hit cross_cap_trace(vec3 ro, vec3 rd, float t0, float t1) {
         }
         // The piece of F holding the first root is chosen first and solved once after,
         // so a SIMD group runs one Newton whichever piece each of its lanes needs.
-        float tol = CROSS_CAP_TOUCH*size;
         bool bracket = false;
         float a = lo;
         float b = lo;
@@ -244,84 +255,90 @@ cross_cap_Hit cross_cap_trace(vec3 ro, vec3 rd, float t0, float t1) {
         // start and its derivative P3 changes sign inside (its extremum, found then,
         // decides: a sign change before it, or a touching root at it). Elsewhere no
         // critical point of F is computed at all.
+        // A walk stops at the first piece that may hide a root pair; that piece's extremum
+        // is found after the walk (one Newton per SIMD group, whichever piece its lanes
+        // stopped at), and a walk starts again after it while it held none.
         float d = cross_cap_P3(ray, lo);
-        if (!found) {
-            float q = x2_0;
-            float fq = cross_cap_P4(ray, q);
-            float dq = cross_cap_P3(ray, q);
-            if (f*fq <= 0.0) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0 && f*d < 0.0) {
-                float m = cross_cap_root3(ray, p, q);
-                float fm = cross_cap_P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0) {
+        int start = 0;
+        float gp = lo;
+        float gq = lo;
+        float gf = 0.0;
+        for (int round = 0; round < 3; ++round) {
+            bool pending = false;
+            if (!found && !pending && start <= 0) {
+                float q = x2_0;
+                float fq = cross_cap_P4(ray, q);
+                float dq = cross_cap_P3(ray, q);
+                if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0 && f*d < 0.0) {
+                    pending = true;
+                    start = 1;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            float q = x2_1;
-            float fq = cross_cap_P4(ray, q);
-            float dq = cross_cap_P3(ray, q);
-            if (f*fq <= 0.0) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0 && f*d < 0.0) {
-                float m = cross_cap_root3(ray, p, q);
-                float fm = cross_cap_P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0) {
+            if (!found && !pending && start <= 1) {
+                float q = x2_1;
+                float fq = cross_cap_P4(ray, q);
+                float dq = cross_cap_P3(ray, q);
+                if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0 && f*d < 0.0) {
+                    pending = true;
+                    start = 2;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            float q = hi;
-            float fq = cross_cap_P4(ray, q);
-            float dq = cross_cap_P3(ray, q);
-            if (f*fq <= 0.0) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0 && f*d < 0.0) {
-                float m = cross_cap_root3(ray, p, q);
-                float fm = cross_cap_P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0) {
+            if (!found && !pending && start <= 2) {
+                float q = hi;
+                float fq = cross_cap_P4(ray, q);
+                float dq = cross_cap_P3(ray, q);
+                if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0 && f*d < 0.0) {
+                    pending = true;
+                    start = 3;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
+            if (!pending) {
+                break;
+            }
+            float m = cross_cap_root3(ray, gp, gq);
+            float fm = cross_cap_P4(ray, m);
+            if (abs(fm) <= CROSS_CAP_TOUCH*cross_cap_scale_at(ray, m)) {
+                found = true;
+                u = m;
+            } else if (gf*fm <= 0.0) {
+                found = true;
+                bracket = true;
+                a = gp;
+                b = m;
+            }
         }
         if (bracket) {
             u = cross_cap_root4(ray, a, b);

@@ -20,11 +20,11 @@
 // ndc = (2(i + 0.5)/width - 1, 1 - 2(j + 0.5)/height) (see README).
 
 // Method constants (implc compile options).
-__constant double TOUCH = 1e-12;
+__constant double TOUCH = 1e-13;
 __constant double HORNER_ERR = 1.7763568394002505e-15;
 __constant double XTOL = 1e-06;
 __constant double CTOL = 0.0003;
-__constant int NEWTON_STEPS = 16;
+__constant int NEWTON_STEPS = 12;
 
 typedef struct {
     double3 o;  // origin of the march, s = 0
@@ -90,6 +90,11 @@ double P3(Ray ray, double u) {
 double ray_F(Ray ray, double u) {
     double h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return (fabs(h) > HORNER_ERR*ray.size ? h : S(ray.o + (u + ray.sm)*ray.d));
+}
+
+// sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
+double scale_at(Ray ray, double u) {
+    return (((fabs(ray.c3) + fabs(ray.c4)*fabs(u))*fabs(u) + fabs(ray.c2))*fabs(u) + fabs(ray.c1))*fabs(u) + fabs(ray.c0);
 }
 
 // P4 = F (ray_F)
@@ -159,11 +164,13 @@ double root3(Ray ray, double a0, double b0) {
             a = x;
             fa = f;
         }
-        double next = x - f/d;
+        double step = f/d;
+        double next = x - step;
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        if (fabs(next - x) <= CTOL*(1.0 + fabs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (fabs(step) <= CTOL*(1.0 + fabs(x))) {
             x = next;
             break;
         }
@@ -191,11 +198,16 @@ double root4(Ray ray, double a0, double b0) {
             a = x;
             fa = f;
         }
-        double next = x - f/d;
+        double step = f/d;
+        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
+        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
+        double lh = step*P2(ray, x)/d;
+        double next = (fabs(lh) < 1.0 ? x - step/(1.0 - 0.5*lh) : x - step);
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        if (fabs(next - x) <= XTOL*(1.0 + fabs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (fabs(step) <= XTOL*(1.0 + fabs(x))) {
             x = next;
             break;
         }
@@ -236,7 +248,6 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
         }
         // The piece of F holding the first root is chosen first and solved once after,
         // so a SIMD group runs one Newton whichever piece each of its lanes needs.
-        double tol = TOUCH*size;
         bool bracket = false;
         double a = lo;
         double b = lo;
@@ -248,84 +259,90 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
         // start and its derivative P3 changes sign inside (its extremum, found then,
         // decides: a sign change before it, or a touching root at it). Elsewhere no
         // critical point of F is computed at all.
+        // A walk stops at the first piece that may hide a root pair; that piece's extremum
+        // is found after the walk (one Newton per SIMD group, whichever piece its lanes
+        // stopped at), and a walk starts again after it while it held none.
         double d = P3(ray, lo);
-        if (!found) {
-            double q = x2_0;
-            double fq = P4(ray, q);
-            double dq = P3(ray, q);
-            if (f*fq <= 0.0) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0 && f*d < 0.0) {
-                double m = root3(ray, p, q);
-                double fm = P4(ray, m);
-                if (fabs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0) {
+        int start = 0;
+        double gp = lo;
+        double gq = lo;
+        double gf = 0.0;
+        for (int round = 0; round < 3; ++round) {
+            bool pending = false;
+            if (!found && !pending && start <= 0) {
+                double q = x2_0;
+                double fq = P4(ray, q);
+                double dq = P3(ray, q);
+                if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0 && f*d < 0.0) {
+                    pending = true;
+                    start = 1;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            double q = x2_1;
-            double fq = P4(ray, q);
-            double dq = P3(ray, q);
-            if (f*fq <= 0.0) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0 && f*d < 0.0) {
-                double m = root3(ray, p, q);
-                double fm = P4(ray, m);
-                if (fabs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0) {
+            if (!found && !pending && start <= 1) {
+                double q = x2_1;
+                double fq = P4(ray, q);
+                double dq = P3(ray, q);
+                if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0 && f*d < 0.0) {
+                    pending = true;
+                    start = 2;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            double q = hi;
-            double fq = P4(ray, q);
-            double dq = P3(ray, q);
-            if (f*fq <= 0.0) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0 && f*d < 0.0) {
-                double m = root3(ray, p, q);
-                double fm = P4(ray, m);
-                if (fabs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0) {
+            if (!found && !pending && start <= 2) {
+                double q = hi;
+                double fq = P4(ray, q);
+                double dq = P3(ray, q);
+                if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0 && f*d < 0.0) {
+                    pending = true;
+                    start = 3;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
+            if (!pending) {
+                break;
+            }
+            double m = root3(ray, gp, gq);
+            double fm = P4(ray, m);
+            if (fabs(fm) <= TOUCH*scale_at(ray, m)) {
+                found = true;
+                u = m;
+            } else if (gf*fm <= 0.0) {
+                found = true;
+                bracket = true;
+                a = gp;
+                b = m;
+            }
         }
         if (bracket) {
             u = root4(ray, a, b);

@@ -19,11 +19,11 @@
 // ndc = (2(i + 0.5)/width - 1, 1 - 2(j + 0.5)/height) (see README).
 
 // Method constants (implc compile options).
-__constant float TOUCH = 1e-12f;
+__constant float TOUCH = 1e-13f;
 __constant float HORNER_ERR = 9.5367431640625e-07f;
 __constant float XTOL = 1e-06f;
 __constant float CTOL = 0.0003f;
-__constant int NEWTON_STEPS = 16;
+__constant int NEWTON_STEPS = 12;
 
 typedef struct {
     float3 o;  // origin of the march, s = 0
@@ -85,6 +85,11 @@ float P3(Ray ray, float u) {
 float ray_F(Ray ray, float u) {
     float h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return (fabs(h) > HORNER_ERR*ray.size ? h : S(ray.o + (u + ray.sm)*ray.d));
+}
+
+// sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
+float scale_at(Ray ray, float u) {
+    return (((fabs(ray.c3) + fabs(ray.c4)*fabs(u))*fabs(u) + fabs(ray.c2))*fabs(u) + fabs(ray.c1))*fabs(u) + fabs(ray.c0);
 }
 
 // P4 = F (ray_F)
@@ -156,11 +161,13 @@ float root3(Ray ray, float a0, float b0) {
             a = x;
             fa = f;
         }
-        float next = x - f/d;
+        float step = f/d;
+        float next = x - step;
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        if (fabs(next - x) <= CTOL*(1.0f + fabs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (fabs(step) <= CTOL*(1.0f + fabs(x))) {
             x = next;
             break;
         }
@@ -188,11 +195,16 @@ float root4(Ray ray, float a0, float b0) {
             a = x;
             fa = f;
         }
-        float next = x - f/d;
+        float step = f/d;
+        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
+        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
+        float lh = step*P2(ray, x)/d;
+        float next = (fabs(lh) < 1.0f ? x - step/(1.0f - 0.5f*lh) : x - step);
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        if (fabs(next - x) <= XTOL*(1.0f + fabs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (fabs(step) <= XTOL*(1.0f + fabs(x))) {
             x = next;
             break;
         }
@@ -233,7 +245,6 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
         }
         // The piece of F holding the first root is chosen first and solved once after,
         // so a SIMD group runs one Newton whichever piece each of its lanes needs.
-        float tol = TOUCH*size;
         bool bracket = false;
         float a = lo;
         float b = lo;
@@ -245,84 +256,90 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
         // start and its derivative P3 changes sign inside (its extremum, found then,
         // decides: a sign change before it, or a touching root at it). Elsewhere no
         // critical point of F is computed at all.
+        // A walk stops at the first piece that may hide a root pair; that piece's extremum
+        // is found after the walk (one Newton per SIMD group, whichever piece its lanes
+        // stopped at), and a walk starts again after it while it held none.
         float d = P3(ray, lo);
-        if (!found) {
-            float q = x2_0;
-            float fq = P4(ray, q);
-            float dq = P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                float m = root3(ray, p, q);
-                float fm = P4(ray, m);
-                if (fabs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+        int start = 0;
+        float gp = lo;
+        float gq = lo;
+        float gf = 0.0f;
+        for (int round = 0; round < 3; ++round) {
+            bool pending = false;
+            if (!found && !pending && start <= 0) {
+                float q = x2_0;
+                float fq = P4(ray, q);
+                float dq = P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 1;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            float q = x2_1;
-            float fq = P4(ray, q);
-            float dq = P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                float m = root3(ray, p, q);
-                float fm = P4(ray, m);
-                if (fabs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+            if (!found && !pending && start <= 1) {
+                float q = x2_1;
+                float fq = P4(ray, q);
+                float dq = P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 2;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            float q = hi;
-            float fq = P4(ray, q);
-            float dq = P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                float m = root3(ray, p, q);
-                float fm = P4(ray, m);
-                if (fabs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+            if (!found && !pending && start <= 2) {
+                float q = hi;
+                float fq = P4(ray, q);
+                float dq = P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 3;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
+            if (!pending) {
+                break;
+            }
+            float m = root3(ray, gp, gq);
+            float fm = P4(ray, m);
+            if (fabs(fm) <= TOUCH*scale_at(ray, m)) {
+                found = true;
+                u = m;
+            } else if (gf*fm <= 0.0f) {
+                found = true;
+                bracket = true;
+                a = gp;
+                b = m;
+            }
         }
         if (bracket) {
             u = root4(ray, a, b);

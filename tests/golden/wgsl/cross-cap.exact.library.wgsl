@@ -17,11 +17,11 @@
 // rd must be unit length; t is measured along rd from ro.
 
 // Method constants (implc compile options).
-const CROSS_CAP_TOUCH: f32 = 1e-12f;
+const CROSS_CAP_TOUCH: f32 = 1e-13f;
 const CROSS_CAP_HORNER_ERR: f32 = 9.5367431640625e-07f;
 const CROSS_CAP_XTOL: f32 = 1e-06f;
 const CROSS_CAP_CTOL: f32 = 0.0003f;
-const CROSS_CAP_NEWTON_STEPS: i32 = 16;
+const CROSS_CAP_NEWTON_STEPS: i32 = 12;
 
 struct cross_cap_Ray {
     o: vec3<f32>,  // origin of the march, s = 0
@@ -87,6 +87,11 @@ fn cross_cap_P3(ray: cross_cap_Ray, u: f32) -> f32 {
 fn cross_cap_ray_F(ray: cross_cap_Ray, u: f32) -> f32 {
     let h: f32 = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return select(cross_cap_S(ray.o + (u + ray.sm)*ray.d), h, abs(h) > CROSS_CAP_HORNER_ERR*ray.size);
+}
+
+// sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
+fn cross_cap_scale_at(ray: cross_cap_Ray, u: f32) -> f32 {
+    return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
 }
 
 // P4 = F (ray_F)
@@ -156,11 +161,13 @@ fn cross_cap_root3(ray: cross_cap_Ray, a0: f32, b0: f32) -> f32 {
             a = x;
             fa = f;
         }
-        var next: f32 = x - f/d;
+        let step: f32 = f/d;
+        var next: f32 = x - step;
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        if (abs(next - x) <= CROSS_CAP_CTOL*(1.0f + abs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (abs(step) <= CROSS_CAP_CTOL*(1.0f + abs(x))) {
             x = next;
             break;
         }
@@ -188,11 +195,16 @@ fn cross_cap_root4(ray: cross_cap_Ray, a0: f32, b0: f32) -> f32 {
             a = x;
             fa = f;
         }
-        var next: f32 = x - f/d;
+        let step: f32 = f/d;
+        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
+        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
+        let lh: f32 = step*cross_cap_P2(ray, x)/d;
+        var next: f32 = select(x - step, x - step/(1.0f - 0.5f*lh), abs(lh) < 1.0f);
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        if (abs(next - x) <= CROSS_CAP_XTOL*(1.0f + abs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (abs(step) <= CROSS_CAP_XTOL*(1.0f + abs(x))) {
             x = next;
             break;
         }
@@ -233,7 +245,6 @@ fn cross_cap_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> cross_cap_
         }
         // The piece of F holding the first root is chosen first and solved once after,
         // so a SIMD group runs one Newton whichever piece each of its lanes needs.
-        let tol: f32 = CROSS_CAP_TOUCH*size;
         var bracket: bool = false;
         var a: f32 = lo;
         var b: f32 = lo;
@@ -245,84 +256,90 @@ fn cross_cap_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> cross_cap_
         // start and its derivative P3 changes sign inside (its extremum, found then,
         // decides: a sign change before it, or a touching root at it). Elsewhere no
         // critical point of F is computed at all.
+        // A walk stops at the first piece that may hide a root pair; that piece's extremum
+        // is found after the walk (one Newton per SIMD group, whichever piece its lanes
+        // stopped at), and a walk starts again after it while it held none.
         var d: f32 = cross_cap_P3(ray, lo);
-        if (!found) {
-            let q: f32 = x2_0;
-            let fq: f32 = cross_cap_P4(ray, q);
-            let dq: f32 = cross_cap_P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                let m: f32 = cross_cap_root3(ray, p, q);
-                let fm: f32 = cross_cap_P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+        var start: i32 = 0;
+        var gp: f32 = lo;
+        var gq: f32 = lo;
+        var gf: f32 = 0.0f;
+        for (var round: i32 = 0; round < 3; round++) {
+            var pending: bool = false;
+            if (!found && !pending && start <= 0) {
+                let q: f32 = x2_0;
+                let fq: f32 = cross_cap_P4(ray, q);
+                let dq: f32 = cross_cap_P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 1;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            let q: f32 = x2_1;
-            let fq: f32 = cross_cap_P4(ray, q);
-            let dq: f32 = cross_cap_P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                let m: f32 = cross_cap_root3(ray, p, q);
-                let fm: f32 = cross_cap_P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+            if (!found && !pending && start <= 1) {
+                let q: f32 = x2_1;
+                let fq: f32 = cross_cap_P4(ray, q);
+                let dq: f32 = cross_cap_P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 2;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            let q: f32 = hi;
-            let fq: f32 = cross_cap_P4(ray, q);
-            let dq: f32 = cross_cap_P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                let m: f32 = cross_cap_root3(ray, p, q);
-                let fm: f32 = cross_cap_P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+            if (!found && !pending && start <= 2) {
+                let q: f32 = hi;
+                let fq: f32 = cross_cap_P4(ray, q);
+                let dq: f32 = cross_cap_P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 3;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
+            if (!pending) {
+                break;
+            }
+            let m: f32 = cross_cap_root3(ray, gp, gq);
+            let fm: f32 = cross_cap_P4(ray, m);
+            if (abs(fm) <= CROSS_CAP_TOUCH*cross_cap_scale_at(ray, m)) {
+                found = true;
+                u = m;
+            } else if (gf*fm <= 0.0f) {
+                found = true;
+                bracket = true;
+                a = gp;
+                b = m;
+            }
         }
         if (bracket) {
             u = cross_cap_root4(ray, a, b);

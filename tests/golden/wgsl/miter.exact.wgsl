@@ -28,11 +28,11 @@ struct Uniforms {
 @group(0) @binding(2) var<storage, read_write> aux_out: array<vec4<f32>>;
 
 // Method constants (implc compile options).
-const TOUCH: f32 = 1e-12f;
+const TOUCH: f32 = 1e-13f;
 const HORNER_ERR: f32 = 9.5367431640625e-07f;
 const XTOL: f32 = 1e-06f;
 const CTOL: f32 = 0.0003f;
-const NEWTON_STEPS: i32 = 16;
+const NEWTON_STEPS: i32 = 12;
 
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0
@@ -98,6 +98,11 @@ fn P3(ray: Ray, u: f32) -> f32 {
 fn ray_F(ray: Ray, u: f32) -> f32 {
     let h: f32 = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return select(S(ray.o + (u + ray.sm)*ray.d), h, abs(h) > HORNER_ERR*ray.size);
+}
+
+// sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
+fn scale_at(ray: Ray, u: f32) -> f32 {
+    return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
 }
 
 // P4 = F (ray_F)
@@ -169,11 +174,13 @@ fn root3(ray: Ray, a0: f32, b0: f32) -> f32 {
             a = x;
             fa = f;
         }
-        var next: f32 = x - f/d;
+        let step: f32 = f/d;
+        var next: f32 = x - step;
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        if (abs(next - x) <= CTOL*(1.0f + abs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (abs(step) <= CTOL*(1.0f + abs(x))) {
             x = next;
             break;
         }
@@ -201,11 +208,16 @@ fn root4(ray: Ray, a0: f32, b0: f32) -> f32 {
             a = x;
             fa = f;
         }
-        var next: f32 = x - f/d;
+        let step: f32 = f/d;
+        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
+        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
+        let lh: f32 = step*P2(ray, x)/d;
+        var next: f32 = select(x - step, x - step/(1.0f - 0.5f*lh), abs(lh) < 1.0f);
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        if (abs(next - x) <= XTOL*(1.0f + abs(x))) {
+        // converged when the Newton step is below the tolerance
+        if (abs(step) <= XTOL*(1.0f + abs(x))) {
             x = next;
             break;
         }
@@ -246,7 +258,6 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         }
         // The piece of F holding the first root is chosen first and solved once after,
         // so a SIMD group runs one Newton whichever piece each of its lanes needs.
-        let tol: f32 = TOUCH*size;
         var bracket: bool = false;
         var a: f32 = lo;
         var b: f32 = lo;
@@ -258,84 +269,90 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         // start and its derivative P3 changes sign inside (its extremum, found then,
         // decides: a sign change before it, or a touching root at it). Elsewhere no
         // critical point of F is computed at all.
+        // A walk stops at the first piece that may hide a root pair; that piece's extremum
+        // is found after the walk (one Newton per SIMD group, whichever piece its lanes
+        // stopped at), and a walk starts again after it while it held none.
         var d: f32 = P3(ray, lo);
-        if (!found) {
-            let q: f32 = x2_0;
-            let fq: f32 = P4(ray, q);
-            let dq: f32 = P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                let m: f32 = root3(ray, p, q);
-                let fm: f32 = P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+        var start: i32 = 0;
+        var gp: f32 = lo;
+        var gq: f32 = lo;
+        var gf: f32 = 0.0f;
+        for (var round: i32 = 0; round < 3; round++) {
+            var pending: bool = false;
+            if (!found && !pending && start <= 0) {
+                let q: f32 = x2_0;
+                let fq: f32 = P4(ray, q);
+                let dq: f32 = P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 1;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            let q: f32 = x2_1;
-            let fq: f32 = P4(ray, q);
-            let dq: f32 = P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                let m: f32 = root3(ray, p, q);
-                let fm: f32 = P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+            if (!found && !pending && start <= 1) {
+                let q: f32 = x2_1;
+                let fq: f32 = P4(ray, q);
+                let dq: f32 = P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 2;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
-        }
-        if (!found) {
-            let q: f32 = hi;
-            let fq: f32 = P4(ray, q);
-            let dq: f32 = P3(ray, q);
-            if (f*fq <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = p;
-                b = q;
-            } else if (d*dq < 0.0f && f*d < 0.0f) {
-                let m: f32 = root3(ray, p, q);
-                let fm: f32 = P4(ray, m);
-                if (abs(fm) <= tol) {
-                    found = true;
-                    u = m;
-                } else if (f*fm <= 0.0f) {
+            if (!found && !pending && start <= 2) {
+                let q: f32 = hi;
+                let fq: f32 = P4(ray, q);
+                let dq: f32 = P3(ray, q);
+                if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
-                    b = m;
+                    b = q;
+                } else if (d*dq < 0.0f && f*d < 0.0f) {
+                    pending = true;
+                    start = 3;
+                    gp = p;
+                    gq = q;
+                    gf = f;
                 }
+                p = q;
+                f = fq;
+                d = dq;
             }
-            p = q;
-            f = fq;
-            d = dq;
+            if (!pending) {
+                break;
+            }
+            let m: f32 = root3(ray, gp, gq);
+            let fm: f32 = P4(ray, m);
+            if (abs(fm) <= TOUCH*scale_at(ray, m)) {
+                found = true;
+                u = m;
+            } else if (gf*fm <= 0.0f) {
+                found = true;
+                bracket = true;
+                a = gp;
+                b = m;
+            }
         }
         if (bracket) {
             u = root4(ray, a, b);
