@@ -70,12 +70,11 @@ lint: setup
 	$(PY) -m ruff check implc tests
 
 # The paper's Table 1 into results/ (docs/RESULTS.md). 1024x1024 like the paper: on this
-# 2-core llvmpipe machine one cross-cap hessian frame takes ~6 s (~38 M march steps/s), the
-# costliest cell (curvature at b = 0.002) ~20 s a frame, and the whole run (3 surfaces x
-# 3 configurations, 4 frames per cell) measured 7.5-11 min, within the ~20 min budget.
+# 2-core llvmpipe machine the costliest cell (curvature at b = 0.002) takes ~1.3 s a
+# frame, and the whole run (3 surfaces x 4 configurations, 6 frames per cell) ~2 min.
 BENCH_SIZE := 1024
 bench: setup
-	$(PY) -m implc bench cross-cap miter steiner --size $(BENCH_SIZE) --frames 3 -o results/
+	$(PY) -m implc bench cross-cap miter steiner --size $(BENCH_SIZE) --frames 5 -o results/
 
 # Generated against the hand-written GLSL of templates/baseline/ (Cross-Cap, taylor and
 # hessian), frames taken in turns: paper = taylor b 0.01 and hessian b 0.002, equal = both

@@ -50,9 +50,10 @@ from .symbols import DIRECTION, POINT
 FORMS = ("point", "ray-poly")
 EVAL_CHOICES = ("auto", *FORMS)
 # `auto` takes ray-poly for polynomials up to this degree (docs/RESULTS.md, "Evaluation
-# forms": float32 Horner on coefficients from the clip-sphere entry measured as accurate
-# as point evaluation there, and faster at every degree measured).
-AUTO_MAX_DEGREE = 12
+# forms"): as accurate as point evaluation at every degree measured (2 to 12), and faster
+# on every bundled polynomial (degree 2 to 6, 2-25 %); above degree 6 the point form was
+# as fast or faster (sums of n-th powers evaluate cheaply at a point by power chains).
+AUTO_MAX_DEGREE = 6
 
 QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
 # What Horner on the ray polynomial gives: F' and F''. F itself, whose sign is the
