@@ -120,6 +120,14 @@ def argv(cmd: str, inp: str, out: str, place: Path) -> list[str]:
     }[cmd]
 
 
+def default_interrupt() -> None:
+    """preexec_fn: SIGINT at its default, as a terminal gives it. A shell without job
+    control starts background jobs with SIGINT ignored (`make test &`, nohup, some CI
+    runners), and a program that inherits an ignored SIGINT keeps ignoring it (Python
+    then installs no KeyboardInterrupt handler), so Ctrl-C could not be tested there."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 PR_CAPBSET_DROP = 24
 CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH = 1, 2
 
@@ -315,7 +323,8 @@ def signal_case(cmd: str, fault: str, place: Path) -> None:
         stdout = write
     proc = subprocess.Popen([sys.executable, "-m", "implc", *args], stdout=stdout,
                             stderr=subprocess.PIPE, text=True, cwd=ROOT,
-                            env=environment(workdir(place, "home")))
+                            env=environment(workdir(place, "home")),
+                            preexec_fn=default_interrupt)
     if write is not None:
         os.close(write)
     ready = {

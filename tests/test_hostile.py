@@ -108,8 +108,11 @@ CASES = load_cases()
 
 
 def limit_memory() -> None:
-    """preexec_fn of every child: bound its address space, so a blow-up is a MemoryError."""
+    """preexec_fn of every child: bound its address space, so a blow-up is a MemoryError;
+    and SIGINT at its default (a background job may inherit it ignored, see
+    tests/test_faults.py `default_interrupt`)."""
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 # --------------------------------------------------------------------------- the batch
