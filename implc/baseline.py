@@ -16,9 +16,10 @@ from .methods import Constants
 from .surface import Surface
 from .targets import get_target
 
-# (surface key, method) pairs that have a hand-written program.
-BASELINES: frozenset[tuple[str, str]] = frozenset({("cross-cap", "taylor"),
-                                                   ("cross-cap", "hessian")})
+# (surface key, method) -> whether its hand-written test is second order (Eq. 4, F''
+# in the interval) rather than first order (Eq. 3): the one switch of the template.
+BASELINES: dict[tuple[str, str], bool] = {("cross-cap", "taylor"): False,
+                                          ("cross-cap", "hessian"): True}
 
 
 def has_baseline(key: str, method: str) -> bool:
@@ -31,6 +32,7 @@ def baseline_program(key: str, method: str, constants: Constants, surface: Surfa
         raise KeyError(f"no hand-written baseline for {key} with {method}")
     printer = get_target("glsl").printer()
     return render_template(f"baseline/{key}.frag.j2", method=method,
+                           second_order=BASELINES[key, method],
                            step=printer.float_literal(constants.step),
                            shading=print_shading(surface.view, printer))
 

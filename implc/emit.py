@@ -159,7 +159,7 @@ def emit(
         "form": form,
         "marcher": marcher,
         "lang": f"{tgt.name}/lang.j2",
-        "T": _types(tgt.vector_types, precision, prefix),
+        "T": _types(tgt, precision, prefix),
         "lit": {k: printer.float_literal(v) for k, v in literals.items()},
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
@@ -177,11 +177,11 @@ def render_template(name: str, **context) -> str:
     return environment().get_template(name).render(context)
 
 
-def _types(vector_types: tuple[str, str, str], precision: str, prefix: str) -> dict:
+def _types(tgt, precision: str, prefix: str) -> dict:
     """The skeleton's abstract type names -> the target's spelling."""
-    real, vec2, vec3 = (t.replace("float", precision) for t in vector_types)
-    return {"real": real, "vec2": vec2, "vec3": vec3, "int": "i32" if real == "f32" else "int",
-            "bool": "bool", "Ray": prefix + "Ray", "Hit": prefix + "Hit"}
+    real, vec2, vec3 = (t.replace("float", precision) for t in tgt.vector_types)
+    return {"real": real, "vec2": vec2, "vec3": vec3, "int": tgt.int_type, "bool": "bool",
+            "Ray": prefix + "Ray", "Hit": prefix + "Hit"}
 
 
 def print_shading(view: View, printer) -> dict:

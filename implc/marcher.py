@@ -63,7 +63,7 @@ QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
 # (measured on the Cross-Cap, Miter and Roman surfaces with hessian at 512^2: 2-6
 # false-hit pixels each where point evaluation has none). The marchers take F at the
 # point (measured: the same false / missed / wrong-root counts as point evaluation on
-# every bundled polynomial, docs/RESULTS.md); the exact solver's `ray_F` returns Horner's
+# every bundled polynomial, docs/RESULTS.md); the exact solver's F (its P_n) is Horner's
 # h where |h| exceeds the bound of its rounding error (HORNER_ERR times the size of F's
 # terms on the interval, in the ray record) and S at the point otherwise, which measured
 # faster there (a march step decides a sign near the surface far more often than the
@@ -324,11 +324,6 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root)
 
 
-def _abs(printer) -> str:
-    """The float absolute value's name (OpenCL's abs is for integers)."""
-    return printer.doprint(sympy.Abs(_sym("h"))).split("(")[0]
-
-
 def _sym(name: str) -> sympy.Symbol:
     return sympy.Symbol(name, real=True)
 
@@ -369,18 +364,15 @@ def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
     hr, half the chord): about the entry point its terms would be up to 3^n times larger
     for the same sum, and float32 Horner loses that much more to cancellation. `size`,
     sum |c_k| hr^k, bounds the terms of F on the interval: the unit of Horner's rounding
-    error (ray_F) and of the exact method's touch tolerance. Storing the coefficients of
-    F' and F'' as well measured slower on llvmpipe (a larger record, the same
-    loop-invariant products)."""
+    error in the exact solver's F. Storing the coefficients of F' and F'' as well
+    measured slower on llvmpipe (a larger record, the same loop-invariant products)."""
     n = len(coefficients.outputs) - 1
     lets = [("vec3", "oc", "ro + sm*rd")]
     lets += [("real", v.name, f"oc.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
     lets += [("real", v.name, f"rd.{c}") for v, c in zip(DIRECTION, _COMPONENT, strict=True)]
     lets += [("real", s.name, printer.doprint(v)) for s, v in coefficients.assignments]
     lets += [("real", f"c{k}", printer.doprint(o)) for k, o in enumerate(coefficients.outputs)]
-    size: sympy.Expr = sympy.S.Zero
-    for k in range(n, -1, -1):
-        size = size * _sym("hr") + sympy.Abs(_sym(f"c{k}"))
+    size = _horner([sympy.Abs(_sym(f"c{k}")) for k in range(n + 1)], _sym("hr"))
     lets.append(("real", "size", printer.doprint(size)))
     fields = (("real", "sm", "the expansion point: F(s) = sum c_k (s - sm)^k"),
               ("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"))
@@ -388,46 +380,48 @@ def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
     return fields, Code(tuple(lets), ("sm", "size", *(f"c{k}" for k in range(n + 1))))
 
 
-def _horner_err(expr: sympy.Expr, printer, prefix: str) -> tuple[str, str, str]:
-    """HORNER_ERR: Horner's rounding error on F is below 2n eps sum |c_k| |u|^k (eps:
-    the unit roundoff); twice that, in units of the ray record's `size`."""
-    n = len(coefficient_program(expr).outputs) - 1
+def _horner_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
+    """HORNER_ERR: Horner's rounding error on F (degree n) is below 2n eps sum |c_k| |u|^k
+    (eps: the unit roundoff); twice that, in units of the ray record's `size`."""
     eps = 2.0**-53 if getattr(printer, "precision", "float") == "double" else 2.0**-24
     return ("real", prefix.upper() + "HORNER_ERR", printer.float_literal(4 * n * eps))
 
 
-def _value_function(n: int, printer, prefix: str) -> ShaderFunction:
-    """ray_F(ray, u): F at u = s - sm, by Horner where its sign is certain, else at the
-    point (see RAY_DERIVATIVES)."""
-    u = _sym("u")
-    value: sympy.Expr = sympy.S.Zero
-    for k in range(n, -1, -1):
-        value = value * u + _sym(f"ray.c{k}")
+def _value_function(name: str, n: int, printer, prefix: str) -> ShaderFunction:
+    """F at u = s - sm, by Horner where its sign is certain, else at the point (see
+    RAY_DERIVATIVES)."""
     at_point = f"{prefix}S(ray.o + (u + ray.sm)*ray.d)"
-    bound = f"{prefix.upper()}HORNER_ERR*ray.size"
+    certain = f"{printer.doprint(sympy.Abs(_sym('h')))} > {prefix.upper()}HORNER_ERR*ray.size"
     return ShaderFunction(
-        "ray_F", "F at u = s - sm: Horner's value where its sign is certain, else S at the "
-        "point", (("Ray", "ray"), ("real", "u")), "real", (("real", "h", printer.doprint(value)),),
-        (printer.print_select(f"{_abs(printer)}(h) > {bound}", "h", at_point),))
+        name, "F at u = s - sm: Horner's value where its sign is certain, else S at the "
+        "point", (("Ray", "ray"), ("real", "u")), "real",
+        (("real", "h", printer.doprint(_derivative(n, 0, _sym("u")))),),
+        (printer.print_select(certain, "h", at_point),))
+
+
+def _horner(coefficients: Sequence[sympy.Expr], x: sympy.Expr) -> sympy.Expr:
+    """sum_k coefficients[k] x^k as a Horner sum."""
+    value: sympy.Expr = sympy.S.Zero
+    for c in reversed(coefficients):
+        value = value * x + c
+    return value
+
+
+def _derivative(n: int, m: int, x: sympy.Expr) -> sympy.Expr:
+    """F^(m) = sum_k k!/(k-m)! c_k x^(k-m) over the ray record's c0..cn, by Horner; the
+    products k!/(k-m)! c_k are loop invariant (a compiler hoists them out of the loop)."""
+    return _horner([sympy.ff(k, m) * _sym(f"ray.c{k}") for k in range(m, n + 1)], x)
 
 
 def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
-    """F^(m)(s) = sum_k k!/(k-m)! c_k s^(k-m), each a Horner sum; the products
-    k!/(k-m)! c_k are loop invariant (a compiler hoists them out of the march loop)."""
-    s = _sym("u")
-    c = [_sym(f"ray.c{k}") for k in range(n + 1)]
-    outputs = []
-    for q in quantities:
-        m = _DERIVATIVE_ORDER[q]
-        value: sympy.Expr = sympy.S.Zero
-        for k in range(n, m - 1, -1):
-            value = value * s + sympy.ff(k, m) * c[k]
-        outputs.append(printer.doprint(value))
+    """F' and/or F'' at ray parameter s, each a Horner sum in u = s - sm."""
+    outputs = tuple(printer.doprint(_derivative(n, _DERIVATIVE_ORDER[q], _sym("u")))
+                    for q in quantities)
     what = ", ".join(quantities)
     return ShaderFunction(_ray_name(quantities),
                           f"{what} at ray parameter s: Horner on the ray polynomial",
                           (("Ray", "ray"), ("real", "s")), _RETURN_TYPE[len(outputs)],
-                          (("real", "u", "s - ray.sm"),), tuple(outputs))
+                          (("real", "u", "s - ray.sm"),), outputs)
 
 
 # --- the exact method: root isolation on the ray polynomial ------------------------------
@@ -443,33 +437,23 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     n = len(coefficients.outputs) - 1
     ray_fields, ray = _ray_setup(coefficients, printer)
     u = _sym("u")
-    c = [_sym(f"ray.c{k}") for k in range(n + 1)]
-    for k in range(1, n + 1):
-        m = n - k  # P_k = F^(m)
-        value: sympy.Expr = sympy.S.Zero
-        for j in range(k, -1, -1):
-            value = value * u + sympy.ff(j + m, m) * c[j + m]
-        what = "F" if m == 0 else "F" + "'" * m if m < 4 else f"F^({m})"
-        if m:  # the derivatives, which only place the pieces: Horner
-            functions.append(ShaderFunction(
-                f"P{k}", f"P{k} = {what}, degree {k} in u = s - sm",
-                (("Ray", "ray"), ("real", "u")), "real", (), (printer.doprint(value),)))
+    for k in range(1, n):  # P_k = F^(n-k): the derivatives, which only place the pieces
+        m = n - k
+        what = "F" + "'" * m if m < 4 else f"F^({m})"
+        functions.append(ShaderFunction(
+            f"P{k}", f"P{k} = {what}, degree {k} in u = s - sm",
+            (("Ray", "ray"), ("real", "u")), "real", (), (printer.doprint(_derivative(n, m, u)),)))
     # F itself, whose sign is the answer: Horner where that sign is certain, else at the
-    # point (ray_F; see RAY_DERIVATIVES)
-    functions.append(_value_function(n, printer, prefix))
-    scale: sympy.Expr = sympy.S.Zero
-    for k in range(n, -1, -1):
-        scale = scale * sympy.Abs(u) + sympy.Abs(c[k])
+    # point (see RAY_DERIVATIVES)
+    functions.append(_value_function(f"P{n}", n, printer, prefix))
+    c = [_sym(f"ray.c{k}") for k in range(n + 1)]
     functions.append(ShaderFunction(
         "scale_at", "sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit "
         "(the reference's own: 1e-12 sum |a_k| s^k)", (("Ray", "ray"), ("real", "u")), "real",
-        (), (printer.doprint(scale),)))
-    functions.append(ShaderFunction(
-        f"P{n}", f"P{n} = F (ray_F)", (("Ray", "ray"), ("real", "u")), "real", (),
-        (f"{prefix}ray_F(ray, u)",)))
+        (), (printer.doprint(_horner([sympy.Abs(ck) for ck in c], sympy.Abs(u))),)))
     K = prefix.upper()
     printed = (("real", K + "TOUCH", printer.float_literal(constants.touch)),
-               _horner_err(expr, printer, prefix),
+               _horner_err(n, printer, prefix),
                ("real", K + "XTOL", printer.float_literal(constants.xtol)),
                ("real", K + "CTOL", printer.float_literal(constants.ctol)),
                ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))))

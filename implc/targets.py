@@ -58,6 +58,7 @@ class Target:
     default_flavor: str = "default"
     precisions: tuple[str, ...] = ("float",)
     vector_types: tuple[str, str, str] = ("float", "vec2", "vec3")  # templates' `types`
+    int_type: str = "int"  # the marcher's loop counters and step counts
 
 
 TARGETS: dict[str, Target] = {target.name: target for target in (
@@ -81,6 +82,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         backends={"wgpu": Backend("implc.render.wgpu_runner:open_wgpu_runner",
                                   "WGSL compute shader on wgpu (Vulkan; lavapipe here)")},
         vector_types=("f32", "vec2<f32>", "vec3<f32>"),
+        int_type="i32",
     ),
     Target(
         name="opencl",

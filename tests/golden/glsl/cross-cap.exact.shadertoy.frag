@@ -73,7 +73,7 @@ float P3(Ray ray, float u) {
 }
 
 // F at u = s - sm: Horner's value where its sign is certain, else S at the point
-float ray_F(Ray ray, float u) {
+float P4(Ray ray, float u) {
     float h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return (abs(h) > HORNER_ERR*ray.size ? h : S(ray.o + (u + ray.sm)*ray.d));
 }
@@ -81,11 +81,6 @@ float ray_F(Ray ray, float u) {
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
 float scale_at(Ray ray, float u) {
     return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
-}
-
-// P4 = F (ray_F)
-float P4(Ray ray, float u) {
-    return ray_F(ray, u);
 }
 
 // The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)

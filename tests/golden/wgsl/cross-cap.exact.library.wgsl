@@ -84,7 +84,7 @@ fn cross_cap_P3(ray: cross_cap_Ray, u: f32) -> f32 {
 }
 
 // F at u = s - sm: Horner's value where its sign is certain, else S at the point
-fn cross_cap_ray_F(ray: cross_cap_Ray, u: f32) -> f32 {
+fn cross_cap_P4(ray: cross_cap_Ray, u: f32) -> f32 {
     let h: f32 = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return select(cross_cap_S(ray.o + (u + ray.sm)*ray.d), h, abs(h) > CROSS_CAP_HORNER_ERR*ray.size);
 }
@@ -92,11 +92,6 @@ fn cross_cap_ray_F(ray: cross_cap_Ray, u: f32) -> f32 {
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
 fn cross_cap_scale_at(ray: cross_cap_Ray, u: f32) -> f32 {
     return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
-}
-
-// P4 = F (ray_F)
-fn cross_cap_P4(ray: cross_cap_Ray, u: f32) -> f32 {
-    return cross_cap_ray_F(ray, u);
 }
 
 // The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)

@@ -95,7 +95,7 @@ fn P3(ray: Ray, u: f32) -> f32 {
 }
 
 // F at u = s - sm: Horner's value where its sign is certain, else S at the point
-fn ray_F(ray: Ray, u: f32) -> f32 {
+fn P4(ray: Ray, u: f32) -> f32 {
     let h: f32 = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
     return select(S(ray.o + (u + ray.sm)*ray.d), h, abs(h) > HORNER_ERR*ray.size);
 }
@@ -103,11 +103,6 @@ fn ray_F(ray: Ray, u: f32) -> f32 {
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
 fn scale_at(ray: Ray, u: f32) -> f32 {
     return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
-}
-
-// P4 = F (ray_F)
-fn P4(ray: Ray, u: f32) -> f32 {
-    return ray_F(ray, u);
 }
 
 // The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
