@@ -1,7 +1,8 @@
 """The Table 1 harness: speed and accuracy of every marcher against the exact reference.
 
 For each configuration x surface x method: one warm-up frame, then `frames` timed frames
-(each `runner.frame()` renders, waits for completion and reads back; the methods of one
+(each `runner.draw()` renders and waits for completion; the read-back of the outputs is
+not part of a frame, as it is not in an application that displays them; the methods of one
 surface take their frames in turns, see `time_interleaved`), reported as the
 median frames per second and as the ratio to `taylor`'s fps in the same run (absolute fps
 depend on the machine; the ratio is what compares across machines). The last timed frame
@@ -224,7 +225,12 @@ def _cpu_model() -> str:
 
 def time_interleaved(runners: Sequence, frames: int) -> tuple[list[list[float]], list]:
     """Seconds of each runner's `frames` frames after one untimed warm-up each, and each
-    runner's last frame.
+    runner's last frame, read back after the timing.
+
+    A timed frame is `draw()`: render and wait for completion (glFinish, queue wait). The
+    read-back of two float32 RGBA targets (32 MB at 1024^2, ~10 ms on llvmpipe) is the
+    same for every method and no part of what an application pays per frame, so timing
+    it would pull every ratio towards 1.
 
     The warm-up absorbs first-use costs (driver shader compilation, allocation). Frames
     are taken in rounds (one frame of every runner per round), so a burst of load from
@@ -234,12 +240,12 @@ def time_interleaved(runners: Sequence, frames: int) -> tuple[list[list[float]],
     for runner in runners:
         runner.frame()
     seconds: list[list[float]] = [[] for _ in runners]
-    last: list = [None] * len(runners)
     for _ in range(frames):
         for index, runner in enumerate(runners):
             start = time.perf_counter()
-            last[index] = runner.frame()
+            runner.draw()
             seconds[index].append(time.perf_counter() - start)
+    last = [runner.read() for runner in runners]
     return seconds, last
 
 
@@ -453,7 +459,8 @@ def format_markdown(run: BenchRun) -> str:
         f"{run.size}x{run.size} pixels, backend `{run.backend}` "
         f"(GL renderer: {machine.get('gl_renderer', 'n/a')}), CPU: {machine['cpu_model']} "
         f"({machine['cpu_count']} logical CPUs). Speed: median fps over {run.frames} frame(s) "
-        "after 1 warm-up frame, each ended by readback; the methods of a surface take "
+        "after 1 warm-up frame, each a draw waited for (glFinish or queue wait; the outputs "
+        "are read back once, after the timing); the methods of a surface take "
         "their frames in turns. Load average (1, 5, 15 min) at start "
         f"{machine.get('load_average_start')}, at end {machine.get('load_average_end')} "
         "(other work on the machine lowers fps).",
