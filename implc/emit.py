@@ -51,13 +51,16 @@ def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program"
     name (parameters only inside constant exponents stay constants, see
     `Surface.uniform_params`)."""
     result = []
+    argument = get_target(target).params_read_as == "argument"
     for i, name in enumerate(surface.uniform_params()):
         uniform = PARAM_UNIFORM_PREFIX + name
         if "__" in uniform:
             raise InputError(f"parameter '{name}' cannot be a shader uniform: names with "
                              "'__' are reserved in GLSL (rename it or use --params constant)")
         value = float(surface.params[name])
-        if target == "wgsl" and emit == "program":
+        if argument:  # a field of the Params struct the functions take
+            result.append(ParamUniform(name, uniform, f"params.{uniform}", value))
+        elif target == "wgsl" and emit == "program":
             result.append(ParamUniform(name, uniform, f"u.{uniform}", value,
                                        WGSL_PARAM_OFFSET + 4 * i))
         elif target == "wgsl":
@@ -135,9 +138,6 @@ def emit(
     if uniforms and tgt.flavors[flavor].get("shadertoy"):
         raise InputError("the shadertoy flavour has no uniforms of its own: use "
                          "--params constant (the default) with --flavor shadertoy")
-    if uniforms and target == "opencl":
-        raise InputError("--params uniform is not available for opencl yet (README "
-                         "\"Parameters as uniforms\"); use --params constant")
     printer = tgt.printer(precision) if len(tgt.precisions) > 1 else tgt.printer()
     expr, equation = surface.expr, surface.equation
     if uniforms:  # the parameters as symbols named as the shader reads them
@@ -146,20 +146,25 @@ def emit(
         equation = surface.symbolic_equation
     # the same form as with --params constant
     form = choose_form(surface.expr, evaluation or constants.evaluation)
-    marcher = lower(meth, constants, expr, form, printer, prefix, current_max_derived())
+    carried = (("Params", "params"),) if uniforms and tgt.params_read_as == "argument" else ()
+    marcher = lower(meth, constants, expr, form, printer, prefix, current_max_derived(),
+                    carried)
     label = meth.name + (f" (Eq. 4: {constants.taylor2})" if meth.reads_taylor2 else "")
+    types = _types(tgt, precision, prefix)
     literals = {"zero": 0.0, "half": 0.5, "one": 1.0, "four": 4.0}
     context = {
         "surface": {"name": surface.name, "equation": equation},
         "params": [{"name": u.name, "uniform": u.uniform, "offset": u.offset,
-                    "value": printer.float_literal(u.value)} for u in uniforms],
+                    "value": printer.float_literal(u.value),
+                    "field": (types["real"], u.uniform, f"parameter {u.name}")}
+                   for u in uniforms],
         "params_struct_size": -(-(WGSL_PARAM_OFFSET + 4 * len(uniforms)) // 16) * 16,
         "method": meth.name,
         "method_label": label,
         "form": form,
         "marcher": marcher,
         "lang": f"{tgt.name}/lang.j2",
-        "T": _types(tgt, precision, prefix),
+        "T": types,
         "lit": {k: printer.float_literal(v) for k, v in literals.items()},
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
@@ -181,7 +186,7 @@ def _types(tgt, precision: str, prefix: str) -> dict:
     """The skeleton's abstract type names -> the target's spelling."""
     real, vec2, vec3 = (t.replace("float", precision) for t in tgt.vector_types)
     return {"real": real, "vec2": vec2, "vec3": vec3, "int": tgt.int_type, "bool": "bool",
-            "Ray": prefix + "Ray", "Hit": prefix + "Hit"}
+            "Ray": prefix + "Ray", "Hit": prefix + "Hit", "Params": prefix + "Params"}
 
 
 def print_shading(view: View, printer) -> dict:

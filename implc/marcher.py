@@ -170,6 +170,12 @@ class Marcher:
     step: Code
     root: Code
     solver: Solver | None = None
+    carried: tuple[tuple[str, str], ...] = ()  # see `lower`
+
+    @property
+    def carried_args(self) -> str:
+        """", params" (the carried arguments, appended to a call), or ""."""
+        return "".join(f", {name}" for _, name in self.carried)
 
 
 # --- what a method evaluates where ---------------------------------------------------
@@ -250,12 +256,18 @@ def coefficient_program(expr: sympy.Expr) -> Program:
 # --- printing ------------------------------------------------------------------------
 
 def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, printer,
-          prefix: str, max_derived: int) -> Marcher:
+          prefix: str, max_derived: int,
+          carried: tuple[tuple[str, str], ...] = ()) -> Marcher:
     """Print the method's pieces in `form` with `printer`; global names start with
-    `prefix`."""
+    `prefix`.
+
+    `carried`: arguments (abstract type, name) that every function evaluating S takes
+    after its own, for a language whose functions cannot read run-time values any other
+    way (OpenCL C's `--params uniform`: `(("Params", "params"),)`). The ray record
+    carries them, so the march's own functions keep their signatures."""
     if method.solves:
         check_exact(expr)
-        return _lower_solver(constants, expr, printer, prefix, max_derived)
+        return _lower_solver(constants, expr, printer, prefix, max_derived, carried)
     const_names = {c: sympy.Symbol(prefix.upper() + c.name, real=True)
                    for c in CONSTANT_SYMBOLS}
 
@@ -264,13 +276,13 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
 
     wanted = evaluations(method, form)
     programs = build_programs(expr, point_sets(method, form), max_derived)
-    functions = [_point_function(name, program, printer) for name, program in programs.items()]
-    ray_fields: tuple[tuple[str, str, str], ...] = ()
-    ray = Code((), ())
+    functions = [_point_function(name, program, printer, carried)
+                 for name, program in programs.items()]
+    ray_fields, ray = _carry(carried, (), Code((), ()))
     if form == "ray-poly":
         coefficients = coefficient_program(expr)
         n = len(coefficients.outputs) - 1
-        ray_fields, ray = _ray_setup(coefficients, printer)
+        ray_fields, ray = _carry(carried, *_ray_setup(coefficients, printer))
         functions += [_horner_function(q, n, printer) for kind, q in wanted if kind == "ray"]
     by_name = {f.name: f for f in functions}
 
@@ -279,7 +291,8 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
         if kind == "ray":
             return f"{prefix}{_ray_name(quantities)}(ray, {show(arg)})"
         fn = by_name[function_name(quantities)]
-        args = [f"ray.o + {at}*ray.d", "ray.d"][: len(fn.params)]
+        args = [f"ray.o + {at}*ray.d", "ray.d"][: len(fn.params) - len(carried)]
+        args += [f"ray.{name}" for _, name in carried]
         return f"{prefix}{fn.name}({', '.join(args)})"
 
     def calls(quantities: tuple[str, ...], arg: sympy.Expr, stem: str, lets: list,
@@ -321,7 +334,8 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
                     for c in CONSTANT_SYMBOLS if c in used)
     printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),
                 ("int", prefix.upper() + "REFINE_STEPS", str(int(constants.refine_steps))))
-    return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root)
+    return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root,
+                   carried=carried)
 
 
 def _sym(name: str) -> sympy.Symbol:
@@ -337,9 +351,11 @@ def _ray_name(quantities: tuple[str, ...]) -> str:
     return "ray_" + function_name(quantities)
 
 
-def _point_function(name: str, program: Program, printer) -> ShaderFunction:
+def _point_function(name: str, program: Program, printer,
+                    carried: tuple[tuple[str, str], ...] = ()) -> ShaderFunction:
     directional = len(program.inputs) == 6
     params = (("vec3", "p"), ("vec3", "d")) if directional else (("vec3", "p"),)
+    params += carried
     lets = [("real", v.name, f"p.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
     if directional:
         lets += [("real", v.name, f"d.{c}") for v, c in zip(DIRECTION, _COMPONENT, strict=True)]
@@ -380,6 +396,14 @@ def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
     return fields, Code(tuple(lets), ("sm", "size", *(f"c{k}" for k in range(n + 1))))
 
 
+def _carry(carried: tuple[tuple[str, str], ...], fields: tuple,
+           ray: Code) -> tuple[tuple, Code]:
+    """The ray record with the carried arguments as fields (ray_of takes them)."""
+    fields += tuple((kind, name, "carried for the functions that evaluate S")
+                    for kind, name in carried)
+    return fields, Code(ray.lets, ray.values + tuple(name for _, name in carried))
+
+
 def _horner_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
     """HORNER_ERR: Horner's rounding error on F (degree n) is below 2n eps sum |c_k| |u|^k
     (eps: the unit roundoff); twice that, in units of the ray record's `size`."""
@@ -387,10 +411,12 @@ def _horner_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
     return ("real", prefix.upper() + "HORNER_ERR", printer.float_literal(4 * n * eps))
 
 
-def _value_function(name: str, n: int, printer, prefix: str) -> ShaderFunction:
+def _value_function(name: str, n: int, printer, prefix: str,
+                    carried: tuple[tuple[str, str], ...]) -> ShaderFunction:
     """F at u = s - sm, by Horner where its sign is certain, else at the point (see
     RAY_DERIVATIVES)."""
-    at_point = f"{prefix}S(ray.o + (u + ray.sm)*ray.d)"
+    extra = "".join(f", ray.{name}" for _, name in carried)
+    at_point = f"{prefix}S(ray.o + (u + ray.sm)*ray.d{extra})"
     certain = f"{printer.doprint(sympy.Abs(_sym('h')))} > {prefix.upper()}HORNER_ERR*ray.size"
     return ShaderFunction(
         name, "F at u = s - sm: Horner's value where its sign is certain, else S at the "
@@ -427,15 +453,16 @@ def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunc
 # --- the exact method: root isolation on the ray polynomial ------------------------------
 
 def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
-                  max_derived: int) -> Marcher:
+                  max_derived: int, carried: tuple[tuple[str, str], ...]) -> Marcher:
     """The pieces of templates/solver.j2: S and grad at the point (shading, residual),
     the ray record with the coefficients, and P_k (k = 1..n), the (n-k)-th derivative of
     F, a degree-k polynomial in u = s - sm, each one Horner sum."""
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
-    functions = [_point_function(name, program, printer) for name, program in programs.items()]
+    functions = [_point_function(name, program, printer, carried)
+                 for name, program in programs.items()]
     coefficients = coefficient_program(expr)
     n = len(coefficients.outputs) - 1
-    ray_fields, ray = _ray_setup(coefficients, printer)
+    ray_fields, ray = _carry(carried, *_ray_setup(coefficients, printer))
     u = _sym("u")
     for k in range(1, n):  # P_k = F^(n-k): the derivatives, which only place the pieces
         m = n - k
@@ -445,7 +472,7 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
             (("Ray", "ray"), ("real", "u")), "real", (), (printer.doprint(_derivative(n, m, u)),)))
     # F itself, whose sign is the answer: Horner where that sign is certain, else at the
     # point (see RAY_DERIVATIVES)
-    functions.append(_value_function(f"P{n}", n, printer, prefix))
+    functions.append(_value_function(f"P{n}", n, printer, prefix, carried))
     c = [_sym(f"ray.c{k}") for k in range(n + 1)]
     functions.append(ShaderFunction(
         "scale_at", "sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit "
@@ -462,4 +489,4 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     closed = tuple(printer.doprint(sympy.ff(j + m, m) * c[j + m]) for j in range(bottom + 1))
     empty = Code((), ())
     return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
-                   empty, Solver(n, bottom, closed))
+                   empty, Solver(n, bottom, closed), carried)

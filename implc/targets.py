@@ -59,6 +59,10 @@ class Target:
     precisions: tuple[str, ...] = ("float",)
     vector_types: tuple[str, str, str] = ("float", "vec2", "vec3")  # templates' `types`
     int_type: str = "int"  # the marcher's loop counters and step counts
+    # how the functions of a `--params uniform` shader read the parameters: "global"
+    # (uniforms, a uniform struct) or "argument" (a Params struct that every function
+    # evaluating S takes: OpenCL C has no program-scope variables set at run time)
+    params_read_as: str = "global"
 
 
 TARGETS: dict[str, Target] = {target.name: target for target in (
@@ -101,6 +105,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         # templates/opencl/ spell double/double2/double3 from `precision`
         precisions=OPENCL_PRECISIONS,
         vector_types=("float", "float2", "float3"),
+        params_read_as="argument",
     ),
 )}
 

@@ -3,6 +3,8 @@
 - the symbolic expression is the substituted one once the values are put back (every
   bundled example with parameters, numerically at seeded random points);
 - every uniform emit validates with its real compiler, and declares what the README says;
+- OpenCL threads them as a Params argument: its emits validate, and a user kernel that
+  pastes the library passes new values per launch and lands on the torus's exact roots;
 - a runner opened once renders new parameter values through set_params without compiling
   again, and each frame is the constant-parameter render of those values (the same
   algorithm with the same values: they differ only by float32 rounding of the folded
@@ -114,8 +116,6 @@ def test_uniform_refusals():
     surface = load_surface("torus")
     with pytest.raises(InputError, match="shadertoy"):
         emit(surface, "glsl", flavor="shadertoy", params="uniform")
-    with pytest.raises(InputError, match="opencl"):
-        emit(surface, "opencl", params="uniform")
     with pytest.raises(InputError, match="--params"):
         emit(surface, params="baked")
     odd = load_surface(equation="x^2 + y^2 + z^2 - a__b", params=["a__b=1"])
@@ -126,17 +126,53 @@ def test_uniform_refusals():
     assert emit(sphere, params="uniform") == emit(sphere)
 
 
-@pytest.mark.parametrize("backend", ["gl", "wgpu"])
+@pytest.mark.parametrize("precision", ["float", "double"])
+@pytest.mark.parametrize("method", ["hessian", "exact"])
+@pytest.mark.parametrize("emit_form", ["program", "library"])
+def test_opencl_uniform_emits_validate(emit_form, method, precision):
+    from test_opencl import require_opencl
+
+    from implc.validate import validate_text
+
+    device = require_opencl()
+    if precision == "double" and not device.has_fp64:
+        pytest.skip(f"{device.name} has no cl_khr_fp64")
+    surface = load_surface("kummer")
+    prefix = "k_" if emit_form == "library" else ""
+    text = emit(surface, "opencl", method, METHODS[method].defaults, emit=emit_form,
+                prefix=prefix, precision=precision, params="uniform")
+    real = precision
+    assert f"}} {prefix}Params;" in text and f"    {real} u_param_mu;" in text
+    # the entry points take the parameters last; the program's kernel after aux
+    assert f"float3 rd, {real} t0, {real} t1, {real}* t, {prefix}Params params)".replace(
+        "float3", f"{real}3") in text
+    assert f"{prefix}S({real}3 p, {prefix}Params params)" in text
+    if emit_form == "program":
+        assert f"__global float4* aux, {real} u_param_mu) {{" in text
+    verdict = validate_text(text, "opencl", f"kummer-{emit_form}.cl")
+    assert verdict.ok, verdict.render(f"kummer-{emit_form}.cl")
+
+
+def _compiled(runner, backend: str):
+    """The runner's compiled object: set_params must keep it."""
+    return {"gl": "program", "wgpu": "pipeline", "cl": "kernel"}[backend]
+
+
+@pytest.mark.parametrize("backend", ["gl", "wgpu", "cl"])
 def test_runner_moves_parameters_without_compiling(backend):
     if backend == "gl":
         require_gl()
-    else:
+    elif backend == "wgpu":
         from test_wgsl import require_wgpu
 
         require_wgpu()
+    else:
+        from test_opencl import require_opencl
+
+        require_opencl()
     surface = load_surface("torus")
     runner = open_runner(surface, backend, "hessian", hessian(), SIZE, SIZE, params="uniform")
-    compiled = runner.program if backend == "gl" else runner.pipeline
+    compiled = getattr(runner, _compiled(runner, backend))
     steps = (({}, []), ({"r": 0.5}, ["r=0.5"]), ({"R": 0.8}, ["R=0.8", "r=0.5"]))
     frames = []
     try:
@@ -144,7 +180,7 @@ def test_runner_moves_parameters_without_compiling(backend):
             if values:
                 runner.set_params(values)
             frames.append(runner.frame())
-        assert (runner.program if backend == "gl" else runner.pipeline) is compiled
+        assert getattr(runner, _compiled(runner, backend)) is compiled
     finally:
         runner.release()
     for i, ((_, params), frame) in enumerate(zip(steps, frames, strict=True)):
@@ -167,5 +203,56 @@ def test_cli_render_and_compile_take_params(tmp_path):
     proc = implc("compile", "kummer", "-t", "wgsl", "--params", "uniform", "--validate")
     assert proc.returncode == 0, proc.stderr
     assert "u_param_mu: f32," in proc.stdout
+    proc = implc("compile", "kummer", "-t", "opencl", "--params", "uniform", "--validate")
+    assert proc.returncode == 0, proc.stderr
+    assert "__global float4* aux, float u_param_mu)" in proc.stdout
+    out = tmp_path / "cl.png"
+    proc = implc("render", "torus", "-b", "cl", "--params", "uniform", "--param", "r=0.5",
+                 "--size", "32", "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
     proc = implc("compile", "torus", "--params", "uniform", "--flavor", "shadertoy")
     assert proc.returncode == 1 and "shadertoy" in proc.stderr
+
+
+USER_KERNEL = """
+__kernel void hits(__global const float* z0, __global float* t_out, float R, float r) {
+    int i = get_global_id(0);
+    to_Params params = {R, r};  // the README's drop-in lines
+    float t;
+    bool hit = to_intersect((float3)(-3.0f, 0.0f, z0[i]), (float3)(1.0f, 0.0f, 0.0f),
+                            0.0f, 6.0f, &t, params);
+    float3 n = to_grad((float3)(-3.0f + t, 0.0f, z0[i]), params);
+    t_out[i] = hit && n.x < 0.0f ? t : -1.0f;  // the outer wall faces the ray
+}
+"""
+
+
+@pytest.mark.parametrize("method", ["exact", "hessian"])
+def test_opencl_library_takes_parameters_at_run_time(method):
+    """A user kernel pastes the library and passes its own parameter values per launch;
+    along y = 0 the first hit of the torus is x = -(R + sqrt(r^2 - z0^2)), exactly."""
+    from test_opencl import require_opencl
+
+    from implc.devices import import_pyopencl, opencl_build
+
+    dev = require_opencl()
+    cl = import_pyopencl()
+    library = emit(load_surface("torus"), "opencl", method, METHODS[method].defaults,
+                   emit="library", prefix="to_", params="uniform")
+    built = opencl_build(library + USER_KERNEL)
+    assert built.program is not None, built.log
+    kernel = cl.Kernel(built.program, "hits")
+    z0 = np.linspace(-0.5, 0.5, 41).astype(np.float32)
+    flags = cl.mem_flags
+    z_buf = cl.Buffer(dev.context, flags.READ_ONLY | flags.COPY_HOST_PTR, hostbuf=z0)
+    t_buf = cl.Buffer(dev.context, flags.WRITE_ONLY, z0.nbytes)
+    for R, r in ((1.0, 0.35), (0.8, 0.45)):  # one build, two launches
+        kernel(dev.queue, z0.shape, None, z_buf, t_buf, np.float32(R), np.float32(r))
+        t = np.empty_like(z0)
+        cl.enqueue_copy(dev.queue, t, t_buf)
+        dev.queue.finish()
+        inside = np.abs(z0) < r - 0.02
+        outside = np.abs(z0) > r + 0.02
+        expected = 3.0 - (R + np.sqrt(np.maximum(r * r - z0 * z0, 0.0)))
+        assert np.all(t[outside] < 0), (R, r, t[outside])
+        np.testing.assert_allclose(t[inside], expected[inside], atol=2e-4)

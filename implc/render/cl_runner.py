@@ -12,10 +12,12 @@ the runner factory signature stays the same for every backend.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+
 import numpy as np
 
 from ..devices import FP64, import_pyopencl, opencl_build, opencl_device
-from ..emit import emit
+from ..emit import ParamUniform, emit, param_uniforms
 from ..errors import ToolError
 from ..methods import Constants
 from ..scene import View
@@ -29,11 +31,14 @@ def _vector3(values, precision: str):
     return make(*(float(v) for v in values))
 
 
+OUTPUT_ARGS = 10  # the kernel's camera, size and clip arguments, then color and aux
+
+
 class ClRunner(TimedRunner):
     """A built program, its kernel and output buffers; `frame()` renders and reads back."""
 
     def __init__(self, source: str, view: View, width: int, height: int,
-                 precision: str = "float"):
+                 precision: str = "float", params: Sequence[ParamUniform] = ()):
         cl = import_pyopencl()
         dev = opencl_device()
         if precision == "double" and not dev.has_fp64:
@@ -48,7 +53,8 @@ class ClRunner(TimedRunner):
         nbytes = width * height * 4 * np.dtype(np.float32).itemsize
         self.color = cl.Buffer(dev.context, cl.mem_flags.WRITE_ONLY, nbytes)
         self.aux = cl.Buffer(dev.context, cl.mem_flags.WRITE_ONLY, nbytes)
-        real = np.float64 if precision == "double" else np.float32
+        self.real = np.float64 if precision == "double" else np.float32
+        real = self.real
         self.kernel.set_args(
             _vector3(view.eye, precision),
             _vector3(view.target, precision),
@@ -60,7 +66,16 @@ class ClRunner(TimedRunner):
             real(view.clip_radius),
             self.color,
             self.aux,
+            *(real(p.value) for p in params),
         )
+        # --params uniform: parameter i is the kernel argument after aux
+        self.param_index = {p.name: OUTPUT_ARGS + i for i, p in enumerate(params)}
+
+    def set_params(self, values: Mapping[str, float]) -> None:
+        """New parameter values for the next frames (a `--params uniform` program): set
+        as kernel arguments, nothing is built again."""
+        for name, value in values.items():
+            self.kernel.set_arg(self.param_index[name], self.real(value))
 
     def draw(self) -> None:
         """Run the kernel over every pixel and wait for it, without reading back."""
@@ -85,12 +100,14 @@ class ClRunner(TimedRunner):
 
 
 def open_cl_runner(surface: Surface, method: str, constants: Constants, width: int,
-                   height: int, precision: str = "float") -> ClRunner:
-    """Runner factory of backend `cl` (float) and, with precision="double", `cl-double`."""
-    source = emit(surface, "opencl", method, constants, precision=precision)
-    return ClRunner(source, surface.view, width, height, precision)
+                   height: int, precision: str = "float", params: str = "constant") -> ClRunner:
+    """Runner factory of backend `cl` (float) and, with precision="double", `cl-double`
+    (params="uniform": the parameters are kernel arguments, moved by `set_params`)."""
+    source = emit(surface, "opencl", method, constants, precision=precision, params=params)
+    uniforms = param_uniforms(surface, "opencl") if params == "uniform" else ()
+    return ClRunner(source, surface.view, width, height, precision, uniforms)
 
 
 def open_cl_double_runner(surface: Surface, method: str, constants: Constants, width: int,
-                          height: int) -> ClRunner:
-    return open_cl_runner(surface, method, constants, width, height, "double")
+                          height: int, params: str = "constant") -> ClRunner:
+    return open_cl_runner(surface, method, constants, width, height, "double", params)

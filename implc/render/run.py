@@ -25,7 +25,7 @@ class Runner(Protocol):
     def release(self) -> None: ...
 
 
-# A runner opened with params="uniform" (gl, wgpu) also has
+# A runner opened with params="uniform" (gl, wgpu, cl, cl-double) also has
 #   set_params(values: Mapping[str, float]) -> None
 # which moves the parameters for the next frames without compiling anything again.
 
