@@ -26,6 +26,7 @@ from implc.render.run import render
 from implc.surface import load_surface
 from implc.symbols import X
 
+ROOT = Path(__file__).resolve().parent.parent
 GOLDEN = Path(__file__).parent / "golden" / "wgsl"
 CASES = wgsl_golden_cases()
 
@@ -237,3 +238,38 @@ def test_same_bytes_for_every_hash_seed():
     outputs = {implc("compile", "miter", "-t", "wgsl", "-m", "curvature",
                      env={"PYTHONHASHSEED": seed}).stdout for seed in ("0", "4242")}
     assert len(outputs) == 1 and "fn march(" in outputs.pop()
+
+
+def _wgsl_layout(struct: str) -> tuple[list[tuple[str, int]], int]:
+    """(field, byte offset) of a WGSL uniform struct of f32, vec2<f32> and vec3<f32>
+    fields, by the WGSL alignment rules, and the struct's size."""
+    align = {"f32": 4, "vec2<f32>": 8, "vec3<f32>": 16}
+    size = {"f32": 4, "vec2<f32>": 8, "vec3<f32>": 12}
+    offset, fields = 0, []
+    for name, kind in re.findall(r"^\s*(\w+): ([\w<>0-9]+),", struct, re.M):
+        offset = -(-offset // align[kind]) * align[kind]
+        fields.append((name, offset))
+        offset += size[kind]
+    largest = max(align[k] for k in re.findall(r": ([\w<>0-9]+),", struct))
+    return fields, -(-offset // largest) * largest
+
+
+def test_readme_rust_uniforms_match_the_wgsl_layout():
+    """The README's `#[repr(C)]` Rust struct (wgpu / Bevy section) puts every field of the
+    torus's `--params uniform` WGSL `Uniforms` at its byte offset, and has its size."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme.split("### wgpu / Bevy-style bind groups", 1)[1]
+    rust = re.search(r"struct Uniforms \{(.*?)\n\}", section, re.S).group(1)
+    offset, rust_fields = 0, {}
+    for name, count in re.findall(r"(\w+): (?:f32|\[f32; (\d)\])", rust):
+        rust_fields[name] = offset  # repr(C) of f32s: 4-byte aligned, no hidden padding
+        offset += 4 * int(count or 1)
+    program = emit(load_surface("torus"), "wgsl", "hessian", METHODS["hessian"].defaults,
+                   params="uniform")
+    struct = re.search(r"struct Uniforms \{(.*?)\n\}", program, re.S).group(1)
+    fields, size = _wgsl_layout(struct)
+    rename = {"u_param_R": "param_big_r", "u_param_r": "param_r"}
+    for name, wgsl_offset in fields:
+        rust_name = rename.get(name, name.removeprefix("u_"))
+        assert rust_fields.get(rust_name) == wgsl_offset, (name, rust_fields)
+    assert offset == size == 96
