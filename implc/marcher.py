@@ -383,17 +383,15 @@ def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
     error in the exact solver's F. Storing the coefficients of F' and F'' as well
     measured slower on llvmpipe (a larger record, the same loop-invariant products)."""
     n = len(coefficients.outputs) - 1
-    lets = [("vec3", "oc", "ro + sm*rd")]
-    lets += [("real", v.name, f"oc.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
+    lets = [("real", v.name, f"oc.{c}") for v, c in zip(POINT, _COMPONENT, strict=True)]
     lets += [("real", v.name, f"rd.{c}") for v, c in zip(DIRECTION, _COMPONENT, strict=True)]
     lets += [("real", s.name, printer.doprint(v)) for s, v in coefficients.assignments]
     lets += [("real", f"c{k}", printer.doprint(o)) for k, o in enumerate(coefficients.outputs)]
     size = _horner([sympy.Abs(_sym(f"c{k}")) for k in range(n + 1)], _sym("hr"))
     lets.append(("real", "size", printer.doprint(size)))
-    fields = (("real", "sm", "the expansion point: F(s) = sum c_k (s - sm)^k"),
-              ("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"))
-    fields += tuple(("real", f"c{k}", f"coefficient of (s - sm)^{k}") for k in range(n + 1))
-    return fields, Code(tuple(lets), ("sm", "size", *(f"c{k}" for k in range(n + 1))))
+    fields = (("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"),)
+    fields += tuple(("real", f"c{k}", f"coefficient of u^{k}") for k in range(n + 1))
+    return fields, Code(tuple(lets), ("size", *(f"c{k}" for k in range(n + 1))))
 
 
 def _carry(carried: tuple[tuple[str, str], ...], fields: tuple,
@@ -413,13 +411,13 @@ def _horner_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
 
 def _value_function(name: str, n: int, printer, prefix: str,
                     carried: tuple[tuple[str, str], ...]) -> ShaderFunction:
-    """F at u = s - sm, by Horner where its sign is certain, else at the point (see
+    """F at u = t - sm, by Horner where its sign is certain, else at the point (see
     RAY_DERIVATIVES)."""
     extra = "".join(f", ray.{name}" for _, name in carried)
-    at_point = f"{prefix}S(ray.o + (u + ray.sm)*ray.d{extra})"
+    at_point = f"{prefix}S(ray.o + u*ray.d{extra})"
     certain = f"{printer.doprint(sympy.Abs(_sym('h')))} > {prefix.upper()}HORNER_ERR*ray.size"
     return ShaderFunction(
-        name, "F at u = s - sm: Horner's value where its sign is certain, else S at the "
+        name, "F at u = t - sm: Horner's value where its sign is certain, else S at the "
         "point", (("Ray", "ray"), ("real", "u")), "real",
         (("real", "h", printer.doprint(_derivative(n, 0, _sym("u")))),),
         (printer.print_select(certain, "h", at_point),))
@@ -440,14 +438,15 @@ def _derivative(n: int, m: int, x: sympy.Expr) -> sympy.Expr:
 
 
 def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
-    """F' and/or F'' at ray parameter s, each a Horner sum in u = s - sm."""
-    outputs = tuple(printer.doprint(_derivative(n, _DERIVATIVE_ORDER[q], _sym("u")))
+    """F' and/or F'' at march parameter s (measured from the ray record's origin, the
+    expansion point), each a Horner sum in s."""
+    outputs = tuple(printer.doprint(_derivative(n, _DERIVATIVE_ORDER[q], _sym("s")))
                     for q in quantities)
     what = ", ".join(quantities)
     return ShaderFunction(_ray_name(quantities),
-                          f"{what} at ray parameter s: Horner on the ray polynomial",
+                          f"{what} at march parameter s: Horner on the ray polynomial",
                           (("Ray", "ray"), ("real", "s")), _RETURN_TYPE[len(outputs)],
-                          (("real", "u", "s - ray.sm"),), outputs)
+                          (), outputs)
 
 
 # --- the exact method: root isolation on the ray polynomial ------------------------------
@@ -456,7 +455,7 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                   max_derived: int, carried: tuple[tuple[str, str], ...]) -> Marcher:
     """The pieces of templates/solver.j2: S and grad at the point (shading, residual),
     the ray record with the coefficients, and P_k (k = 1..n), the (n-k)-th derivative of
-    F, a degree-k polynomial in u = s - sm, each one Horner sum."""
+    F, a degree-k polynomial in u = t - sm, each one Horner sum."""
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
     functions = [_point_function(name, program, printer, carried)
                  for name, program in programs.items()]
@@ -468,7 +467,7 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         m = n - k
         what = "F" + "'" * m if m < 4 else f"F^({m})"
         functions.append(ShaderFunction(
-            f"P{k}", f"P{k} = {what}, degree {k} in u = s - sm",
+            f"P{k}", f"P{k} = {what}, degree {k} in u = t - sm",
             (("Ray", "ray"), ("real", "u")), "real", (), (printer.doprint(_derivative(n, m, u)),)))
     # F itself, whose sign is the answer: Horner where that sign is certain, else at the
     # point (see RAY_DERIVATIVES)

@@ -14,8 +14,9 @@ const int MAX_STEPS = 20000;
 const int REFINE_STEPS = 10;
 
 struct Ray {
-    vec3 o;  // origin of the march, s = 0
+    vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
+    float sm;  // where o lies on the caller's ray: t = sm + s
 };
 
 struct Hit {
@@ -156,9 +157,13 @@ vec2 SD(vec3 p, vec3 d) {
     return vec2(-t2 - t5 - t8 + 0.6, dx*(-t2*(4.0 - t10) + 8.0*t5*x - t8*(-t10 - 3.2)) + dy*(8.0*t2*y - t5*(-t11 - 2.4) - t8*(3.2 - t11)) + dz*(t2*t9 - t5*(4.0 - t9) + t8*t9));
 }
 
-// The ray a march runs on: o + s d (sm and hr are not used by the point form).
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length).
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
-    return Ray(ro, rd);
+    vec3 oc = ro + sm*rd;
+    return Ray(oc, rd, sm);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
@@ -183,7 +188,7 @@ float step_size(Ray ray, float s, vec3 f0) {
 bool root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     float r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
-    return max(f0.x, max(f1.x, max(q, r))) >= 0.0 && min(f0.x, min(f1.x, min(q, r))) <= 0.0;
+    return max(max(f0.x, f1.x), max(q, r)) >= 0.0 && min(min(f0.x, f1.x), min(q, r)) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
@@ -217,21 +222,24 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
 // march to the first step that may hold a root and leave the loop, then refine once.
 // (Refining inside the loop would make a SIMD group run the refinement once for every
-// distinct step at which one of its lanes finds a root.) Start the ray near the surface
-// (e.g. at its clip-sphere entry) to keep float32 t small.
+// distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
+// over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
+// float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
-    float s = t0;
-    vec3 f = values_at(ray, t0);
-    float s1 = t0;
+    float lo = t0 - ray.sm;
+    float hi = t1 - ray.sm;
+    float s = lo;
+    vec3 f = values_at(ray, lo);
+    float s1 = lo;
     vec3 f1 = f;
     bool found = false;
     int steps = 0;
     for (int i = 0; i < MAX_STEPS; ++i) {
-        if (s >= t1) {
+        if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), t1);
+        s1 = min(s + step_size(ray, s, f), hi);
         f1 = values_at(ray, s1);
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
@@ -243,7 +251,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     float t = t1;
     if (found) {
-        t = refine(ray, s, s1, f.x, f1.x);
+        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return Hit(found, t, steps);
 }

@@ -25,15 +25,15 @@ const float CTOL = 0.0003;
 const int NEWTON_STEPS = 12;
 
 struct Ray {
-    vec3 o;  // origin of the march, s = 0
+    vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
-    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float sm;  // where o lies on the caller's ray: t = sm + s
     float size;  // sum |c_k| hr^k: the size of F's terms on the interval
-    float c0;  // coefficient of (s - sm)^0
-    float c1;  // coefficient of (s - sm)^1
-    float c2;  // coefficient of (s - sm)^2
-    float c3;  // coefficient of (s - sm)^3
-    float c4;  // coefficient of (s - sm)^4
+    float c0;  // coefficient of u^0
+    float c1;  // coefficient of u^1
+    float c2;  // coefficient of u^2
+    float c3;  // coefficient of u^3
+    float c4;  // coefficient of u^4
 };
 
 struct Hit {
@@ -69,25 +69,25 @@ vec3 grad(vec3 p) {
     return vec3(8.0*x*(t0 + x_2) + 8.0*x_3, t1*y - 2.0*y*(1.0 - t0) + 2.0*y_3, t1*z + 2.0*y_2*z);
 }
 
-// P1 = F''', degree 1 in u = s - sm
+// P1 = F''', degree 1 in u = t - sm
 float P1(Ray ray, float u) {
     return 6.0*ray.c3 + 24.0*ray.c4*u;
 }
 
-// P2 = F'', degree 2 in u = s - sm
+// P2 = F'', degree 2 in u = t - sm
 float P2(Ray ray, float u) {
     return 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u);
 }
 
-// P3 = F', degree 3 in u = s - sm
+// P3 = F', degree 3 in u = t - sm
 float P3(Ray ray, float u) {
     return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
 }
 
-// F at u = s - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Horner's value where its sign is certain, else S at the point
 float P4(Ray ray, float u) {
     float h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return (abs(h) > HORNER_ERR*ray.size ? h : S(ray.o + (u + ray.sm)*ray.d));
+    return (abs(h) > HORNER_ERR*ray.size ? h : S(ray.o + u*ray.d));
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
@@ -95,8 +95,10 @@ float scale_at(Ray ray, float u) {
     return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     vec3 oc = ro + sm*rd;
     float x = oc.x;
@@ -131,7 +133,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float c3 = -dy_2*t6 + t10*t9 + t12*t8 - t13*t4;
     float c4 = -dy_2*t13 + t10*t12;
     float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // The root of P3 in [a, b], where P3 is monotonic (Newton bracketed by [a, b], a step

@@ -14,14 +14,14 @@ const int MAX_STEPS = 20000;
 const int REFINE_STEPS = 10;
 
 struct Ray {
-    vec3 o;  // origin of the march, s = 0
+    vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
-    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float sm;  // where o lies on the caller's ray: t = sm + s
     float size;  // sum |c_k| hr^k: the size of F's terms on the interval
-    float c0;  // coefficient of (s - sm)^0
-    float c1;  // coefficient of (s - sm)^1
-    float c2;  // coefficient of (s - sm)^2
-    float c3;  // coefficient of (s - sm)^3
+    float c0;  // coefficient of u^0
+    float c1;  // coefficient of u^1
+    float c2;  // coefficient of u^2
+    float c3;  // coefficient of u^3
 };
 
 struct Hit {
@@ -49,20 +49,20 @@ vec3 grad(vec3 p) {
     return vec3(2.0*x, -2.0*y*z, -y_2);
 }
 
-// dS, d2S at ray parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Horner on the ray polynomial
 vec2 ray_DH(Ray ray, float s) {
-    float u = s - ray.sm;
-    return vec2(ray.c1 + u*(2.0*ray.c2 + 3.0*ray.c3*u), 2.0*ray.c2 + 6.0*ray.c3*u);
+    return vec2(ray.c1 + s*(2.0*ray.c2 + 3.0*ray.c3*s), 2.0*ray.c2 + 6.0*ray.c3*s);
 }
 
-// dS at ray parameter s: Horner on the ray polynomial
+// dS at march parameter s: Horner on the ray polynomial
 float ray_dS(Ray ray, float s) {
-    float u = s - ray.sm;
-    return ray.c1 + u*(2.0*ray.c2 + 3.0*ray.c3*u);
+    return ray.c1 + s*(2.0*ray.c2 + 3.0*ray.c3*s);
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     vec3 oc = ro + sm*rd;
     float x = oc.x;
@@ -81,7 +81,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float c2 = dx_2 - dy_2*z - dz*t0;
     float c3 = -dy_2*dz;
     float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(ro, rd, sm, size, c0, c1, c2, c3);
+    return Ray(oc, rd, sm, size, c0, c1, c2, c3);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
@@ -108,7 +108,7 @@ float step_size(Ray ray, float s, vec3 f0) {
 bool root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     float r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
-    return max(f0.x, max(f1.x, max(q, r))) >= 0.0 && min(f0.x, min(f1.x, min(q, r))) <= 0.0;
+    return max(max(f0.x, f1.x), max(q, r)) >= 0.0 && min(min(f0.x, f1.x), min(q, r)) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
@@ -142,21 +142,24 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
 // march to the first step that may hold a root and leave the loop, then refine once.
 // (Refining inside the loop would make a SIMD group run the refinement once for every
-// distinct step at which one of its lanes finds a root.) Start the ray near the surface
-// (e.g. at its clip-sphere entry) to keep float32 t small.
+// distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
+// over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
+// float32 t small.
 Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
-    float s = t0;
-    vec3 f = values_at(ray, t0);
-    float s1 = t0;
+    float lo = t0 - ray.sm;
+    float hi = t1 - ray.sm;
+    float s = lo;
+    vec3 f = values_at(ray, lo);
+    float s1 = lo;
     vec3 f1 = f;
     bool found = false;
     int steps = 0;
     for (int i = 0; i < MAX_STEPS; ++i) {
-        if (s >= t1) {
+        if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), t1);
+        s1 = min(s + step_size(ray, s, f), hi);
         f1 = values_at(ray, s1);
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
@@ -168,7 +171,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     }
     float t = t1;
     if (found) {
-        t = refine(ray, s, s1, f.x, f1.x);
+        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return Hit(found, t, steps);
 }

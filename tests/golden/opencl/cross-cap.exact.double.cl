@@ -27,15 +27,15 @@ __constant double CTOL = 0.0003;
 __constant int NEWTON_STEPS = 12;
 
 typedef struct {
-    double3 o;  // origin of the march, s = 0
+    double3 o;  // origin of the march, s = 0: the point ro + sm rd
     double3 d;  // unit direction
-    double sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    double sm;  // where o lies on the caller's ray: t = sm + s
     double size;  // sum |c_k| hr^k: the size of F's terms on the interval
-    double c0;  // coefficient of (s - sm)^0
-    double c1;  // coefficient of (s - sm)^1
-    double c2;  // coefficient of (s - sm)^2
-    double c3;  // coefficient of (s - sm)^3
-    double c4;  // coefficient of (s - sm)^4
+    double c0;  // coefficient of u^0
+    double c1;  // coefficient of u^1
+    double c2;  // coefficient of u^2
+    double c3;  // coefficient of u^3
+    double c4;  // coefficient of u^4
 } Ray;
 
 typedef struct {
@@ -71,25 +71,25 @@ double3 grad(double3 p) {
     return (double3)(8.0*x*(t0 + x_2 + z) + 8.0*x_3, 8.0*x_2*y + 2.0*y*(t0 - 1.0) + 2.0*y_3, t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
-// P1 = F''', degree 1 in u = s - sm
+// P1 = F''', degree 1 in u = t - sm
 double P1(Ray ray, double u) {
     return 6.0*ray.c3 + 24.0*ray.c4*u;
 }
 
-// P2 = F'', degree 2 in u = s - sm
+// P2 = F'', degree 2 in u = t - sm
 double P2(Ray ray, double u) {
     return 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u);
 }
 
-// P3 = F', degree 3 in u = s - sm
+// P3 = F', degree 3 in u = t - sm
 double P3(Ray ray, double u) {
     return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
 }
 
-// F at u = s - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Horner's value where its sign is certain, else S at the point
 double P4(Ray ray, double u) {
     double h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return (fabs(h) > HORNER_ERR*ray.size ? h : S(ray.o + (u + ray.sm)*ray.d));
+    return (fabs(h) > HORNER_ERR*ray.size ? h : S(ray.o + u*ray.d));
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
@@ -97,8 +97,10 @@ double scale_at(Ray ray, double u) {
     return (((fabs(ray.c3) + fabs(ray.c4)*fabs(u))*fabs(u) + fabs(ray.c2))*fabs(u) + fabs(ray.c1))*fabs(u) + fabs(ray.c0);
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     double3 oc = ro + sm*rd;
     double x = oc.x;
@@ -131,7 +133,7 @@ Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     double c3 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
     double c4 = dy_2*t9 + t10*t11;
     double size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){ro, rd, sm, size, c0, c1, c2, c3, c4};
+    return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
 // The root of P3 in [a, b], where P3 is monotonic (Newton bracketed by [a, b], a step

@@ -26,15 +26,15 @@ __constant float CROSS_CAP_CTOL = 0.0003f;
 __constant int CROSS_CAP_NEWTON_STEPS = 12;
 
 typedef struct {
-    float3 o;  // origin of the march, s = 0
+    float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
-    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float sm;  // where o lies on the caller's ray: t = sm + s
     float size;  // sum |c_k| hr^k: the size of F's terms on the interval
-    float c0;  // coefficient of (s - sm)^0
-    float c1;  // coefficient of (s - sm)^1
-    float c2;  // coefficient of (s - sm)^2
-    float c3;  // coefficient of (s - sm)^3
-    float c4;  // coefficient of (s - sm)^4
+    float c0;  // coefficient of u^0
+    float c1;  // coefficient of u^1
+    float c2;  // coefficient of u^2
+    float c3;  // coefficient of u^3
+    float c4;  // coefficient of u^4
 } cross_cap_Ray;
 
 typedef struct {
@@ -70,25 +70,25 @@ float3 cross_cap_grad(float3 p) {
     return (float3)(8.0f*x*(t0 + x_2 + z) + 8.0f*x_3, 8.0f*x_2*y + 2.0f*y*(t0 - 1.0f) + 2.0f*y_3, t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
 }
 
-// P1 = F''', degree 1 in u = s - sm
+// P1 = F''', degree 1 in u = t - sm
 float cross_cap_P1(cross_cap_Ray ray, float u) {
     return 6.0f*ray.c3 + 24.0f*ray.c4*u;
 }
 
-// P2 = F'', degree 2 in u = s - sm
+// P2 = F'', degree 2 in u = t - sm
 float cross_cap_P2(cross_cap_Ray ray, float u) {
     return 2.0f*ray.c2 + u*(6.0f*ray.c3 + 12.0f*ray.c4*u);
 }
 
-// P3 = F', degree 3 in u = s - sm
+// P3 = F', degree 3 in u = t - sm
 float cross_cap_P3(cross_cap_Ray ray, float u) {
     return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
 }
 
-// F at u = s - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Horner's value where its sign is certain, else S at the point
 float cross_cap_P4(cross_cap_Ray ray, float u) {
     float h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return (fabs(h) > CROSS_CAP_HORNER_ERR*ray.size ? h : cross_cap_S(ray.o + (u + ray.sm)*ray.d));
+    return (fabs(h) > CROSS_CAP_HORNER_ERR*ray.size ? h : cross_cap_S(ray.o + u*ray.d));
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
@@ -96,8 +96,10 @@ float cross_cap_scale_at(cross_cap_Ray ray, float u) {
     return (((fabs(ray.c3) + fabs(ray.c4)*fabs(u))*fabs(u) + fabs(ray.c2))*fabs(u) + fabs(ray.c1))*fabs(u) + fabs(ray.c0);
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 cross_cap_Ray cross_cap_ray_of(float3 ro, float3 rd, float sm, float hr) {
     float3 oc = ro + sm*rd;
     float x = oc.x;
@@ -130,7 +132,7 @@ cross_cap_Ray cross_cap_ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c3 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
     float c4 = dy_2*t9 + t10*t11;
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (cross_cap_Ray){ro, rd, sm, size, c0, c1, c2, c3, c4};
+    return (cross_cap_Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
 // The root of P3 in [a, b], where P3 is monotonic (Newton bracketed by [a, b], a step

@@ -28,15 +28,15 @@ __constant int MAX_STEPS = 20000;
 __constant int REFINE_STEPS = 10;
 
 typedef struct {
-    double3 o;  // origin of the march, s = 0
+    double3 o;  // origin of the march, s = 0: the point ro + sm rd
     double3 d;  // unit direction
-    double sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    double sm;  // where o lies on the caller's ray: t = sm + s
     double size;  // sum |c_k| hr^k: the size of F's terms on the interval
-    double c0;  // coefficient of (s - sm)^0
-    double c1;  // coefficient of (s - sm)^1
-    double c2;  // coefficient of (s - sm)^2
-    double c3;  // coefficient of (s - sm)^3
-    double c4;  // coefficient of (s - sm)^4
+    double c0;  // coefficient of u^0
+    double c1;  // coefficient of u^1
+    double c2;  // coefficient of u^2
+    double c3;  // coefficient of u^3
+    double c4;  // coefficient of u^4
 } Ray;
 
 typedef struct {
@@ -72,20 +72,20 @@ double3 grad(double3 p) {
     return (double3)(8.0*x*(t0 + x_2 + z) + 8.0*x_3, 8.0*x_2*y + 2.0*y*(t0 - 1.0) + 2.0*y_3, t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
-// dS, d2S at ray parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Horner on the ray polynomial
 double2 ray_DH(Ray ray, double s) {
-    double u = s - ray.sm;
-    return (double2)(ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u)), 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u));
+    return (double2)(ray.c1 + s*(2.0*ray.c2 + s*(3.0*ray.c3 + 4.0*ray.c4*s)), 2.0*ray.c2 + s*(6.0*ray.c3 + 12.0*ray.c4*s));
 }
 
-// dS at ray parameter s: Horner on the ray polynomial
+// dS at march parameter s: Horner on the ray polynomial
 double ray_dS(Ray ray, double s) {
-    double u = s - ray.sm;
-    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
+    return ray.c1 + s*(2.0*ray.c2 + s*(3.0*ray.c3 + 4.0*ray.c4*s));
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     double3 oc = ro + sm*rd;
     double x = oc.x;
@@ -118,7 +118,7 @@ Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     double c3 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
     double c4 = dy_2*t9 + t10*t11;
     double size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){ro, rd, sm, size, c0, c1, c2, c3, c4};
+    return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
@@ -145,7 +145,7 @@ double step_size(Ray ray, double s, double3 f0) {
 bool root_in(double3 f0, double3 f1, double h) {
     double q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     double r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
-    return fmax(f0.x, fmax(f1.x, fmax(q, r))) >= 0.0 && fmin(f0.x, fmin(f1.x, fmin(q, r))) <= 0.0;
+    return fmax(fmax(f0.x, f1.x), fmax(q, r)) >= 0.0 && fmin(fmin(f0.x, f1.x), fmin(q, r)) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
@@ -179,21 +179,24 @@ double refine(Ray ray, double a0, double b0, double fa0, double fb) {
 // Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
 // march to the first step that may hold a root and leave the loop, then refine once.
 // (Refining inside the loop would make a SIMD group run the refinement once for every
-// distinct step at which one of its lanes finds a root.) Start the ray near the surface
-// (e.g. at its clip-sphere entry) to keep float32 t small.
+// distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
+// over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
+// float32 t small.
 Hit trace(double3 ro, double3 rd, double t0, double t1) {
     Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
-    double s = t0;
-    double3 f = values_at(ray, t0);
-    double s1 = t0;
+    double lo = t0 - ray.sm;
+    double hi = t1 - ray.sm;
+    double s = lo;
+    double3 f = values_at(ray, lo);
+    double s1 = lo;
     double3 f1 = f;
     bool found = false;
     int steps = 0;
     for (int i = 0; i < MAX_STEPS; ++i) {
-        if (s >= t1) {
+        if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), t1);
+        s1 = min(s + step_size(ray, s, f), hi);
         f1 = values_at(ray, s1);
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
@@ -205,7 +208,7 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
     }
     double t = t1;
     if (found) {
-        t = refine(ray, s, s1, f.x, f1.x);
+        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return (Hit){found, t, steps};
 }

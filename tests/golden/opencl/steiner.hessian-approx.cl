@@ -28,15 +28,15 @@ __constant int MAX_STEPS = 20000;
 __constant int REFINE_STEPS = 10;
 
 typedef struct {
-    float3 o;  // origin of the march, s = 0
+    float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
-    float sm;  // the expansion point: F(s) = sum c_k (s - sm)^k
+    float sm;  // where o lies on the caller's ray: t = sm + s
     float size;  // sum |c_k| hr^k: the size of F's terms on the interval
-    float c0;  // coefficient of (s - sm)^0
-    float c1;  // coefficient of (s - sm)^1
-    float c2;  // coefficient of (s - sm)^2
-    float c3;  // coefficient of (s - sm)^3
-    float c4;  // coefficient of (s - sm)^4
+    float c0;  // coefficient of u^0
+    float c1;  // coefficient of u^1
+    float c2;  // coefficient of u^2
+    float c3;  // coefficient of u^3
+    float c4;  // coefficient of u^4
 } Ray;
 
 typedef struct {
@@ -68,14 +68,15 @@ float3 grad(float3 p) {
     return (float3)(2.0f*x*y_2 - 2.0f*x*z_2 - y*z, t0*x_2 + t0*z_2 - x*z, -x*y - 2.0f*x_2*z + 2.0f*y_2*z);
 }
 
-// dS at ray parameter s: Horner on the ray polynomial
+// dS at march parameter s: Horner on the ray polynomial
 float ray_dS(Ray ray, float s) {
-    float u = s - ray.sm;
-    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
+    return ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s));
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float3 oc = ro + sm*rd;
     float x = oc.x;
@@ -110,7 +111,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c3 = dy_2*t12 + 2.0f*dy_2*t6 - dz*t10 - dz_2*t12 + 2.0f*dz_2*t5 + t13*t5 - t13*t6;
     float c4 = dx_2*dy_2 - dx_2*dz_2 + dy_2*dz_2;
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){ro, rd, sm, size, c0, c1, c2, c3, c4};
+    return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
@@ -138,7 +139,7 @@ float step_size(Ray ray, float s, float3 f0) {
 bool root_in(float3 f0, float3 f1, float h) {
     float q = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
     float r = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
-    return fmax(f0.x, fmax(f1.x, fmax(q, r))) >= 0.0f && fmin(f0.x, fmin(f1.x, fmin(q, r))) <= 0.0f;
+    return fmax(fmax(f0.x, f1.x), fmax(q, r)) >= 0.0f && fmin(fmin(f0.x, f1.x), fmin(q, r)) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
@@ -172,21 +173,24 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
 // march to the first step that may hold a root and leave the loop, then refine once.
 // (Refining inside the loop would make a SIMD group run the refinement once for every
-// distinct step at which one of its lanes finds a root.) Start the ray near the surface
-// (e.g. at its clip-sphere entry) to keep float32 t small.
+// distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
+// over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
+// float32 t small.
 Hit trace(float3 ro, float3 rd, float t0, float t1) {
     Ray ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
-    float s = t0;
-    float3 f = values_at(ray, t0);
-    float s1 = t0;
+    float lo = t0 - ray.sm;
+    float hi = t1 - ray.sm;
+    float s = lo;
+    float3 f = values_at(ray, lo);
+    float s1 = lo;
     float3 f1 = f;
     bool found = false;
     int steps = 0;
     for (int i = 0; i < MAX_STEPS; ++i) {
-        if (s >= t1) {
+        if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), t1);
+        s1 = min(s + step_size(ray, s, f), hi);
         f1 = values_at(ray, s1);
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
@@ -198,7 +202,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     }
     float t = t1;
     if (found) {
-        t = refine(ray, s, s1, f.x, f1.x);
+        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return (Hit){found, t, steps};
 }

@@ -36,8 +36,9 @@ const MAX_STEPS: i32 = 20000;
 const REFINE_STEPS: i32 = 10;
 
 struct Ray {
-    o: vec3<f32>,  // origin of the march, s = 0
+    o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
+    sm: f32,  // where o lies on the caller's ray: t = sm + s
 }
 
 struct Hit {
@@ -178,9 +179,13 @@ fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(-t2 - t5 - t8 + 0.6f, dx*(-t2*(4.0f - t10) + 8.0f*t5*x - t8*(-t10 - 3.2f)) + dy*(8.0f*t2*y - t5*(-t11 - 2.4f) - t8*(3.2f - t11)) + dz*(t2*t9 - t5*(4.0f - t9) + t8*t9));
 }
 
-// The ray a march runs on: o + s d (sm and hr are not used by the point form).
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length).
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
-    return Ray(ro, rd);
+    let oc: vec3<f32> = ro + sm*rd;
+    return Ray(oc, rd, sm);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
@@ -205,7 +210,7 @@ fn step_size(ray: Ray, s: f32, f0: vec3<f32>) -> f32 {
 fn root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
     let q: f32 = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
     let r: f32 = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
-    return max(f0.x, max(f1.x, max(q, r))) >= 0.0f && min(f0.x, min(f1.x, min(q, r))) <= 0.0f;
+    return max(max(f0.x, f1.x), max(q, r)) >= 0.0f && min(min(f0.x, f1.x), min(q, r)) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
@@ -239,21 +244,24 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
 // march to the first step that may hold a root and leave the loop, then refine once.
 // (Refining inside the loop would make a SIMD group run the refinement once for every
-// distinct step at which one of its lanes finds a root.) Start the ray near the surface
-// (e.g. at its clip-sphere entry) to keep float32 t small.
+// distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
+// over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
+// float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
-    var s: f32 = t0;
-    var f: vec3<f32> = values_at(ray, t0);
-    var s1: f32 = t0;
+    let lo: f32 = t0 - ray.sm;
+    let hi: f32 = t1 - ray.sm;
+    var s: f32 = lo;
+    var f: vec3<f32> = values_at(ray, lo);
+    var s1: f32 = lo;
     var f1: vec3<f32> = f;
     var found: bool = false;
     var steps: i32 = 0;
     for (var i: i32 = 0; i < MAX_STEPS; i++) {
-        if (s >= t1) {
+        if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), t1);
+        s1 = min(s + step_size(ray, s, f), hi);
         f1 = values_at(ray, s1);
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
@@ -265,7 +273,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     var t: f32 = t1;
     if (found) {
-        t = refine(ray, s, s1, f.x, f1.x);
+        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return Hit(found, t, steps);
 }

@@ -35,15 +35,15 @@ const CTOL: f32 = 0.0003f;
 const NEWTON_STEPS: i32 = 12;
 
 struct Ray {
-    o: vec3<f32>,  // origin of the march, s = 0
+    o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
-    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    sm: f32,  // where o lies on the caller's ray: t = sm + s
     size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
-    c0: f32,  // coefficient of (s - sm)^0
-    c1: f32,  // coefficient of (s - sm)^1
-    c2: f32,  // coefficient of (s - sm)^2
-    c3: f32,  // coefficient of (s - sm)^3
-    c4: f32,  // coefficient of (s - sm)^4
+    c0: f32,  // coefficient of u^0
+    c1: f32,  // coefficient of u^1
+    c2: f32,  // coefficient of u^2
+    c3: f32,  // coefficient of u^3
+    c4: f32,  // coefficient of u^4
 }
 
 struct Hit {
@@ -79,25 +79,25 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(8.0f*x*(t0 + x_2 + z) + 8.0f*x_3, 8.0f*x_2*y + 2.0f*y*(t0 - 1.0f) + 2.0f*y_3, t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
 }
 
-// P1 = F''', degree 1 in u = s - sm
+// P1 = F''', degree 1 in u = t - sm
 fn P1(ray: Ray, u: f32) -> f32 {
     return 6.0f*ray.c3 + 24.0f*ray.c4*u;
 }
 
-// P2 = F'', degree 2 in u = s - sm
+// P2 = F'', degree 2 in u = t - sm
 fn P2(ray: Ray, u: f32) -> f32 {
     return 2.0f*ray.c2 + u*(6.0f*ray.c3 + 12.0f*ray.c4*u);
 }
 
-// P3 = F', degree 3 in u = s - sm
+// P3 = F', degree 3 in u = t - sm
 fn P3(ray: Ray, u: f32) -> f32 {
     return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
 }
 
-// F at u = s - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Horner's value where its sign is certain, else S at the point
 fn P4(ray: Ray, u: f32) -> f32 {
     let h: f32 = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return select(S(ray.o + (u + ray.sm)*ray.d), h, abs(h) > HORNER_ERR*ray.size);
+    return select(S(ray.o + u*ray.d), h, abs(h) > HORNER_ERR*ray.size);
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
@@ -105,8 +105,10 @@ fn scale_at(ray: Ray, u: f32) -> f32 {
     return (((abs(ray.c3) + abs(ray.c4)*abs(u))*abs(u) + abs(ray.c2))*abs(u) + abs(ray.c1))*abs(u) + abs(ray.c0);
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let oc: vec3<f32> = ro + sm*rd;
     let x: f32 = oc.x;
@@ -139,7 +141,7 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let c3: f32 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
     let c4: f32 = dy_2*t9 + t10*t11;
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // The root of P3 in [a, b], where P3 is monotonic (Newton bracketed by [a, b], a step

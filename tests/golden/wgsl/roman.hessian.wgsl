@@ -36,15 +36,15 @@ const MAX_STEPS: i32 = 20000;
 const REFINE_STEPS: i32 = 10;
 
 struct Ray {
-    o: vec3<f32>,  // origin of the march, s = 0
+    o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
-    sm: f32,  // the expansion point: F(s) = sum c_k (s - sm)^k
+    sm: f32,  // where o lies on the caller's ray: t = sm + s
     size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
-    c0: f32,  // coefficient of (s - sm)^0
-    c1: f32,  // coefficient of (s - sm)^1
-    c2: f32,  // coefficient of (s - sm)^2
-    c3: f32,  // coefficient of (s - sm)^3
-    c4: f32,  // coefficient of (s - sm)^4
+    c0: f32,  // coefficient of u^0
+    c1: f32,  // coefficient of u^1
+    c2: f32,  // coefficient of u^2
+    c3: f32,  // coefficient of u^3
+    c4: f32,  // coefficient of u^4
 }
 
 struct Hit {
@@ -78,20 +78,20 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(t0*y_2 + t0*z_2 - y*z, t1*x_2 + t1*z_2 - x*z, t2*x_2 + t2*y_2 - x*y);
 }
 
-// dS, d2S at ray parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Horner on the ray polynomial
 fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
-    let u: f32 = s - ray.sm;
-    return vec2<f32>(ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u)), 2.0f*ray.c2 + u*(6.0f*ray.c3 + 12.0f*ray.c4*u));
+    return vec2<f32>(ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s)), 2.0f*ray.c2 + s*(6.0f*ray.c3 + 12.0f*ray.c4*s));
 }
 
-// dS at ray parameter s: Horner on the ray polynomial
+// dS at march parameter s: Horner on the ray polynomial
 fn ray_dS(ray: Ray, s: f32) -> f32 {
-    let u: f32 = s - ray.sm;
-    return ray.c1 + u*(2.0f*ray.c2 + u*(3.0f*ray.c3 + 4.0f*ray.c4*u));
+    return ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s));
 }
 
-// The ray a march runs on: o + s d, with the coefficients of F(s) = S(o + s d)
-// expanded about s = sm, the middle of the march interval, hr its half length.
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
 fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let oc: vec3<f32> = ro + sm*rd;
     let x: f32 = oc.x;
@@ -127,7 +127,7 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let c3: f32 = dx_2*t13 + dx_2*t14 + dy_2*t12 + dy_2*t14 - dz*t10 + dz_2*t12 + dz_2*t13;
     let c4: f32 = dx_2*dy_2 + dx_2*dz_2 + dy_2*dz_2;
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(ro, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value.
@@ -154,7 +154,7 @@ fn step_size(ray: Ray, s: f32, f0: vec3<f32>) -> f32 {
 fn root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
     let q: f32 = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
     let r: f32 = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
-    return max(f0.x, max(f1.x, max(q, r))) >= 0.0f && min(f0.x, min(f1.x, min(q, r))) <= 0.0f;
+    return max(max(f0.x, f1.x), max(q, r)) >= 0.0f && min(min(f0.x, f1.x), min(q, r)) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
@@ -188,21 +188,24 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // Adaptive Marching Points (Algorithm 1) over [t0, t1] of the ray ro + t rd (|rd| = 1):
 // march to the first step that may hold a root and leave the loop, then refine once.
 // (Refining inside the loop would make a SIMD group run the refinement once for every
-// distinct step at which one of its lanes finds a root.) Start the ray near the surface
-// (e.g. at its clip-sphere entry) to keep float32 t small.
+// distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
+// over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
+// float32 t small.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
-    var s: f32 = t0;
-    var f: vec3<f32> = values_at(ray, t0);
-    var s1: f32 = t0;
+    let lo: f32 = t0 - ray.sm;
+    let hi: f32 = t1 - ray.sm;
+    var s: f32 = lo;
+    var f: vec3<f32> = values_at(ray, lo);
+    var s1: f32 = lo;
     var f1: vec3<f32> = f;
     var found: bool = false;
     var steps: i32 = 0;
     for (var i: i32 = 0; i < MAX_STEPS; i++) {
-        if (s >= t1) {
+        if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), t1);
+        s1 = min(s + step_size(ray, s, f), hi);
         f1 = values_at(ray, s1);
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
@@ -214,7 +217,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     }
     var t: f32 = t1;
     if (found) {
-        t = refine(ray, s, s1, f.x, f1.x);
+        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return Hit(found, t, steps);
 }
