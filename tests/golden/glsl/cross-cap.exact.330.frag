@@ -134,15 +134,15 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
-// The root of P3 in [a, b], where P3 is monotonic (Newton bracketed by [a, b], a step
-// that leaves it or meets P2 = 0 becomes the midpoint; stops when the step is below
-// CTOL); b when P3 does not change sign on [a, b].
+// The root of P3 in [a, b], where P3 is monotonic and fa0, fb0 are its values at a0, b0
+// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
+// bracketed by [a, b], a step that leaves it or meets P2 = 0 becomes the midpoint;
+// stops when the step is below CTOL; b when P3 does not change sign on [a, b].
 
-float root3(Ray ray, float a0, float b0) {
+float root3(Ray ray, float a0, float b0, float fa0, float fb) {
     float a = a0;
     float b = b0;
-    float fa = P3(ray, a);
-    float fb = P3(ray, b);
+    float fa = fa0;
     if (fa*fb > 0.0 || !(a < b)) {
         return b;
     }
@@ -159,14 +159,14 @@ float root3(Ray ray, float a0, float b0) {
             a = x;
             fa = f;
         }
-        float step = f/d;
-        float next = x - step;
+        float next = x - f/d;
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        // converged when the Newton step is below the tolerance
-        if (abs(step) <= CTOL*(1.0 + abs(x))) {
-            x = next;
+        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
+        // a root, kept as it is where d = 0 too)
+        if (abs(f) <= CTOL*(1.0 + abs(x))*abs(d)) {
+            x = (d != 0.0 ? next : x);
             break;
         }
         x = next;
@@ -174,15 +174,15 @@ float root3(Ray ray, float a0, float b0) {
     return x;
 }
 
-// The root of P4 in [a, b], where P4 is monotonic (Newton bracketed by [a, b], a step
-// that leaves it or meets P3 = 0 becomes the midpoint; stops when the step is below
-// XTOL); b when P4 does not change sign on [a, b].
+// The root of P4 in [a, b], where P4 is monotonic and fa0, fb0 are its values at a0, b0
+// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
+// bracketed by [a, b], a step that leaves it or meets P3 = 0 becomes the midpoint;
+// stops when the step is below XTOL; b when P4 does not change sign on [a, b].
 
-float root4(Ray ray, float a0, float b0) {
+float root4(Ray ray, float a0, float b0, float fa0, float fb) {
     float a = a0;
     float b = b0;
-    float fa = P4(ray, a);
-    float fb = P4(ray, b);
+    float fa = fa0;
     float x = (fb != fa ? a - fa*(b - a)/(fb - fa) : 0.5*(a + b));
     for (int i = 0; i < NEWTON_STEPS; ++i) {
         float f = P4(ray, x);
@@ -193,17 +193,19 @@ float root4(Ray ray, float a0, float b0) {
             a = x;
             fa = f;
         }
-        float step = f/d;
-        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
-        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
-        float lh = step*P2(ray, x)/d;
-        float next = (abs(lh) < 1.0 ? x - step/(1.0 - 0.5*lh) : x - step);
+        // Halley's step where its correction is moderate (|f F''| < F'^2; F'' = P2 is at
+        // hand): x - f F'/(F'^2 - f F''/2), cubic convergence; else Newton's, x - f F'/F'^2.
+        // One division either way (it is the slow operation of the loop).
+        float dd = d*d;
+        float fh = f*P2(ray, x);
+        float next = x - f*d/(dd - (abs(fh) < dd ? 0.5*fh : 0.0));
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        // converged when the Newton step is below the tolerance
-        if (abs(step) <= XTOL*(1.0 + abs(x))) {
-            x = next;
+        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
+        // a root, kept as it is where d = 0 too)
+        if (abs(f) <= XTOL*(1.0 + abs(x))*abs(d)) {
+            x = (d != 0.0 ? next : x);
             break;
         }
         x = next;
@@ -248,6 +250,8 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
         float b = lo;
         float p = lo;
         float f = P4(ray, lo);
+        float fa = f;
+        float fb = f;
         // F along the pieces between the roots of F'' = P2, in order. On each, F'' keeps
         // its sign, so F is convex or concave there: opposite signs at the ends mean exactly
         // one root; the same sign can hide a root only when F heads towards zero at the
@@ -256,29 +260,43 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
         // critical point of F is computed at all.
         // A walk stops at the first piece that may hide a root pair; that piece's extremum
         // is found after the walk (one Newton per SIMD group, whichever piece its lanes
-        // stopped at), and a walk starts again after it while it held none.
+        // stopped at), and a walk starts again after it while it held none. F and F' at
+        // every piece end are evaluated once, before the walk: a SIMD group needs each of
+        // them for some lane.
         float d = P3(ray, lo);
+        float fe0 = P4(ray, x2_0);
+        float de0 = P3(ray, x2_0);
+        float fe1 = P4(ray, x2_1);
+        float de1 = P3(ray, x2_1);
+        float fe2 = P4(ray, hi);
+        float de2 = P3(ray, hi);
         int start = 0;
         float gp = lo;
         float gq = lo;
         float gf = 0.0;
+        float gd = 0.0;
+        float gdq = 0.0;
         for (int round = 0; round < 3; ++round) {
             bool pending = false;
             if (!found && !pending && start <= 0) {
                 float q = x2_0;
-                float fq = P4(ray, q);
-                float dq = P3(ray, q);
+                float fq = fe0;
+                float dq = de0;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 1;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -286,19 +304,23 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
             }
             if (!found && !pending && start <= 1) {
                 float q = x2_1;
-                float fq = P4(ray, q);
-                float dq = P3(ray, q);
+                float fq = fe1;
+                float dq = de1;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 2;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -306,19 +328,23 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
             }
             if (!found && !pending && start <= 2) {
                 float q = hi;
-                float fq = P4(ray, q);
-                float dq = P3(ray, q);
+                float fq = fe2;
+                float dq = de2;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 3;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -327,7 +353,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
             if (!pending) {
                 break;
             }
-            float m = root3(ray, gp, gq);
+            float m = root3(ray, gp, gq, gd, gdq);
             float fm = P4(ray, m);
             if (abs(fm) <= TOUCH*scale_at(ray, m)) {
                 found = true;
@@ -337,10 +363,12 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
                 bracket = true;
                 a = gp;
                 b = m;
+                fa = gf;
+                fb = fm;
             }
         }
         if (bracket) {
-            u = root4(ray, a, b);
+            u = root4(ray, a, b, fa, fb);
         }
     }
     return Hit(found, (found ? u + ray.sm : t1), 0);

@@ -136,15 +136,15 @@ Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
-// The root of P3 in [a, b], where P3 is monotonic (Newton bracketed by [a, b], a step
-// that leaves it or meets P2 = 0 becomes the midpoint; stops when the step is below
-// CTOL); b when P3 does not change sign on [a, b].
+// The root of P3 in [a, b], where P3 is monotonic and fa0, fb0 are its values at a0, b0
+// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
+// bracketed by [a, b], a step that leaves it or meets P2 = 0 becomes the midpoint;
+// stops when the step is below CTOL; b when P3 does not change sign on [a, b].
 
-double root3(Ray ray, double a0, double b0) {
+double root3(Ray ray, double a0, double b0, double fa0, double fb) {
     double a = a0;
     double b = b0;
-    double fa = P3(ray, a);
-    double fb = P3(ray, b);
+    double fa = fa0;
     if (fa*fb > 0.0 || !(a < b)) {
         return b;
     }
@@ -161,14 +161,14 @@ double root3(Ray ray, double a0, double b0) {
             a = x;
             fa = f;
         }
-        double step = f/d;
-        double next = x - step;
+        double next = x - f/d;
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        // converged when the Newton step is below the tolerance
-        if (fabs(step) <= CTOL*(1.0 + fabs(x))) {
-            x = next;
+        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
+        // a root, kept as it is where d = 0 too)
+        if (fabs(f) <= CTOL*(1.0 + fabs(x))*fabs(d)) {
+            x = (d != 0.0 ? next : x);
             break;
         }
         x = next;
@@ -176,15 +176,15 @@ double root3(Ray ray, double a0, double b0) {
     return x;
 }
 
-// The root of P4 in [a, b], where P4 is monotonic (Newton bracketed by [a, b], a step
-// that leaves it or meets P3 = 0 becomes the midpoint; stops when the step is below
-// XTOL); b when P4 does not change sign on [a, b].
+// The root of P4 in [a, b], where P4 is monotonic and fa0, fb0 are its values at a0, b0
+// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
+// bracketed by [a, b], a step that leaves it or meets P3 = 0 becomes the midpoint;
+// stops when the step is below XTOL; b when P4 does not change sign on [a, b].
 
-double root4(Ray ray, double a0, double b0) {
+double root4(Ray ray, double a0, double b0, double fa0, double fb) {
     double a = a0;
     double b = b0;
-    double fa = P4(ray, a);
-    double fb = P4(ray, b);
+    double fa = fa0;
     double x = (fb != fa ? a - fa*(b - a)/(fb - fa) : 0.5*(a + b));
     for (int i = 0; i < NEWTON_STEPS; ++i) {
         double f = P4(ray, x);
@@ -195,17 +195,19 @@ double root4(Ray ray, double a0, double b0) {
             a = x;
             fa = f;
         }
-        double step = f/d;
-        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
-        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
-        double lh = step*P2(ray, x)/d;
-        double next = (fabs(lh) < 1.0 ? x - step/(1.0 - 0.5*lh) : x - step);
+        // Halley's step where its correction is moderate (|f F''| < F'^2; F'' = P2 is at
+        // hand): x - f F'/(F'^2 - f F''/2), cubic convergence; else Newton's, x - f F'/F'^2.
+        // One division either way (it is the slow operation of the loop).
+        double dd = d*d;
+        double fh = f*P2(ray, x);
+        double next = x - f*d/(dd - (fabs(fh) < dd ? 0.5*fh : 0.0));
         if (d == 0.0 || !(next >= a && next <= b)) {
             next = 0.5*(a + b);
         }
-        // converged when the Newton step is below the tolerance
-        if (fabs(step) <= XTOL*(1.0 + fabs(x))) {
-            x = next;
+        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
+        // a root, kept as it is where d = 0 too)
+        if (fabs(f) <= XTOL*(1.0 + fabs(x))*fabs(d)) {
+            x = (d != 0.0 ? next : x);
             break;
         }
         x = next;
@@ -250,6 +252,8 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
         double b = lo;
         double p = lo;
         double f = P4(ray, lo);
+        double fa = f;
+        double fb = f;
         // F along the pieces between the roots of F'' = P2, in order. On each, F'' keeps
         // its sign, so F is convex or concave there: opposite signs at the ends mean exactly
         // one root; the same sign can hide a root only when F heads towards zero at the
@@ -258,29 +262,43 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
         // critical point of F is computed at all.
         // A walk stops at the first piece that may hide a root pair; that piece's extremum
         // is found after the walk (one Newton per SIMD group, whichever piece its lanes
-        // stopped at), and a walk starts again after it while it held none.
+        // stopped at), and a walk starts again after it while it held none. F and F' at
+        // every piece end are evaluated once, before the walk: a SIMD group needs each of
+        // them for some lane.
         double d = P3(ray, lo);
+        double fe0 = P4(ray, x2_0);
+        double de0 = P3(ray, x2_0);
+        double fe1 = P4(ray, x2_1);
+        double de1 = P3(ray, x2_1);
+        double fe2 = P4(ray, hi);
+        double de2 = P3(ray, hi);
         int start = 0;
         double gp = lo;
         double gq = lo;
         double gf = 0.0;
+        double gd = 0.0;
+        double gdq = 0.0;
         for (int round = 0; round < 3; ++round) {
             bool pending = false;
             if (!found && !pending && start <= 0) {
                 double q = x2_0;
-                double fq = P4(ray, q);
-                double dq = P3(ray, q);
+                double fq = fe0;
+                double dq = de0;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 1;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -288,19 +306,23 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
             }
             if (!found && !pending && start <= 1) {
                 double q = x2_1;
-                double fq = P4(ray, q);
-                double dq = P3(ray, q);
+                double fq = fe1;
+                double dq = de1;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 2;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -308,19 +330,23 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
             }
             if (!found && !pending && start <= 2) {
                 double q = hi;
-                double fq = P4(ray, q);
-                double dq = P3(ray, q);
+                double fq = fe2;
+                double dq = de2;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 3;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -329,7 +355,7 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
             if (!pending) {
                 break;
             }
-            double m = root3(ray, gp, gq);
+            double m = root3(ray, gp, gq, gd, gdq);
             double fm = P4(ray, m);
             if (fabs(fm) <= TOUCH*scale_at(ray, m)) {
                 found = true;
@@ -339,10 +365,12 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
                 bracket = true;
                 a = gp;
                 b = m;
+                fa = gf;
+                fb = fm;
             }
         }
         if (bracket) {
-            u = root4(ray, a, b);
+            u = root4(ray, a, b, fa, fb);
         }
     }
     return (Hit){found, (found ? u + ray.sm : t1), 0};

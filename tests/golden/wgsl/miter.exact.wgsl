@@ -146,15 +146,15 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
-// The root of P3 in [a, b], where P3 is monotonic (Newton bracketed by [a, b], a step
-// that leaves it or meets P2 = 0 becomes the midpoint; stops when the step is below
-// CTOL); b when P3 does not change sign on [a, b].
+// The root of P3 in [a, b], where P3 is monotonic and fa0, fb0 are its values at a0, b0
+// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
+// bracketed by [a, b], a step that leaves it or meets P2 = 0 becomes the midpoint;
+// stops when the step is below CTOL; b when P3 does not change sign on [a, b].
 
-fn root3(ray: Ray, a0: f32, b0: f32) -> f32 {
+fn root3(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
     var a: f32 = a0;
     var b: f32 = b0;
-    var fa: f32 = P3(ray, a);
-    let fb: f32 = P3(ray, b);
+    var fa: f32 = fa0;
     if (fa*fb > 0.0f || !(a < b)) {
         return b;
     }
@@ -171,14 +171,14 @@ fn root3(ray: Ray, a0: f32, b0: f32) -> f32 {
             a = x;
             fa = f;
         }
-        let step: f32 = f/d;
-        var next: f32 = x - step;
+        var next: f32 = x - f/d;
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        // converged when the Newton step is below the tolerance
-        if (abs(step) <= CTOL*(1.0f + abs(x))) {
-            x = next;
+        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
+        // a root, kept as it is where d = 0 too)
+        if (abs(f) <= CTOL*(1.0f + abs(x))*abs(d)) {
+            x = select(x, next, d != 0.0f);
             break;
         }
         x = next;
@@ -186,15 +186,15 @@ fn root3(ray: Ray, a0: f32, b0: f32) -> f32 {
     return x;
 }
 
-// The root of P4 in [a, b], where P4 is monotonic (Newton bracketed by [a, b], a step
-// that leaves it or meets P3 = 0 becomes the midpoint; stops when the step is below
-// XTOL); b when P4 does not change sign on [a, b].
+// The root of P4 in [a, b], where P4 is monotonic and fa0, fb0 are its values at a0, b0
+// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
+// bracketed by [a, b], a step that leaves it or meets P3 = 0 becomes the midpoint;
+// stops when the step is below XTOL; b when P4 does not change sign on [a, b].
 
-fn root4(ray: Ray, a0: f32, b0: f32) -> f32 {
+fn root4(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
     var a: f32 = a0;
     var b: f32 = b0;
-    var fa: f32 = P4(ray, a);
-    let fb: f32 = P4(ray, b);
+    var fa: f32 = fa0;
     var x: f32 = select(0.5f*(a + b), a - fa*(b - a)/(fb - fa), fb != fa);
     for (var i: i32 = 0; i < NEWTON_STEPS; i++) {
         let f: f32 = P4(ray, x);
@@ -205,17 +205,19 @@ fn root4(ray: Ray, a0: f32, b0: f32) -> f32 {
             a = x;
             fa = f;
         }
-        let step: f32 = f/d;
-        // Halley's correction of the Newton step (F'' = P2 is at hand): cubic
-        // convergence, where the correction is moderate (|f F''/F'^2| < 1); else Newton's
-        let lh: f32 = step*P2(ray, x)/d;
-        var next: f32 = select(x - step, x - step/(1.0f - 0.5f*lh), abs(lh) < 1.0f);
+        // Halley's step where its correction is moderate (|f F''| < F'^2; F'' = P2 is at
+        // hand): x - f F'/(F'^2 - f F''/2), cubic convergence; else Newton's, x - f F'/F'^2.
+        // One division either way (it is the slow operation of the loop).
+        let dd: f32 = d*d;
+        let fh: f32 = f*P2(ray, x);
+        var next: f32 = x - f*d/(dd - select(0.0f, 0.5f*fh, abs(fh) < dd));
         if (d == 0.0f || !(next >= a && next <= b)) {
             next = 0.5f*(a + b);
         }
-        // converged when the Newton step is below the tolerance
-        if (abs(step) <= XTOL*(1.0f + abs(x))) {
-            x = next;
+        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
+        // a root, kept as it is where d = 0 too)
+        if (abs(f) <= XTOL*(1.0f + abs(x))*abs(d)) {
+            x = select(x, next, d != 0.0f);
             break;
         }
         x = next;
@@ -260,6 +262,8 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         var b: f32 = lo;
         var p: f32 = lo;
         var f: f32 = P4(ray, lo);
+        var fa: f32 = f;
+        var fb: f32 = f;
         // F along the pieces between the roots of F'' = P2, in order. On each, F'' keeps
         // its sign, so F is convex or concave there: opposite signs at the ends mean exactly
         // one root; the same sign can hide a root only when F heads towards zero at the
@@ -268,29 +272,43 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         // critical point of F is computed at all.
         // A walk stops at the first piece that may hide a root pair; that piece's extremum
         // is found after the walk (one Newton per SIMD group, whichever piece its lanes
-        // stopped at), and a walk starts again after it while it held none.
+        // stopped at), and a walk starts again after it while it held none. F and F' at
+        // every piece end are evaluated once, before the walk: a SIMD group needs each of
+        // them for some lane.
         var d: f32 = P3(ray, lo);
+        let fe0: f32 = P4(ray, x2_0);
+        let de0: f32 = P3(ray, x2_0);
+        let fe1: f32 = P4(ray, x2_1);
+        let de1: f32 = P3(ray, x2_1);
+        let fe2: f32 = P4(ray, hi);
+        let de2: f32 = P3(ray, hi);
         var start: i32 = 0;
         var gp: f32 = lo;
         var gq: f32 = lo;
         var gf: f32 = 0.0f;
+        var gd: f32 = 0.0f;
+        var gdq: f32 = 0.0f;
         for (var round: i32 = 0; round < 3; round++) {
             var pending: bool = false;
             if (!found && !pending && start <= 0) {
                 let q: f32 = x2_0;
-                let fq: f32 = P4(ray, q);
-                let dq: f32 = P3(ray, q);
+                let fq: f32 = fe0;
+                let dq: f32 = de0;
                 if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0f && f*d < 0.0f) {
                     pending = true;
                     start = 1;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -298,19 +316,23 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             }
             if (!found && !pending && start <= 1) {
                 let q: f32 = x2_1;
-                let fq: f32 = P4(ray, q);
-                let dq: f32 = P3(ray, q);
+                let fq: f32 = fe1;
+                let dq: f32 = de1;
                 if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0f && f*d < 0.0f) {
                     pending = true;
                     start = 2;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -318,19 +340,23 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             }
             if (!found && !pending && start <= 2) {
                 let q: f32 = hi;
-                let fq: f32 = P4(ray, q);
-                let dq: f32 = P3(ray, q);
+                let fq: f32 = fe2;
+                let dq: f32 = de2;
                 if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
                     a = p;
                     b = q;
+                    fa = f;
+                    fb = fq;
                 } else if (d*dq < 0.0f && f*d < 0.0f) {
                     pending = true;
                     start = 3;
                     gp = p;
                     gq = q;
                     gf = f;
+                    gd = d;
+                    gdq = dq;
                 }
                 p = q;
                 f = fq;
@@ -339,7 +365,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             if (!pending) {
                 break;
             }
-            let m: f32 = root3(ray, gp, gq);
+            let m: f32 = root3(ray, gp, gq, gd, gdq);
             let fm: f32 = P4(ray, m);
             if (abs(fm) <= TOUCH*scale_at(ray, m)) {
                 found = true;
@@ -349,10 +375,12 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 bracket = true;
                 a = gp;
                 b = m;
+                fa = gf;
+                fb = fm;
             }
         }
         if (bracket) {
-            u = root4(ray, a, b);
+            u = root4(ray, a, b, fa, fb);
         }
     }
     return Hit(found, select(t1, u + ray.sm, found), 0);
