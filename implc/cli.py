@@ -32,7 +32,14 @@ from .errors import (
     InputError,
     ValidationError,
 )
-from .fileio import FULL_DISK, check_output, check_output_dir, describe_os_error, write_atomic
+from .fileio import (
+    FULL_DISK,
+    check_output,
+    check_output_dir,
+    describe_os_error,
+    read_input,
+    write_atomic,
+)
 from .marcher import AUTO_MAX_DEGREE, EVAL_CHOICES, EXACT_MAX_DEGREE
 from .methods import METHODS, TAYLOR2_CHOICES, Constants
 from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
@@ -524,14 +531,7 @@ def cmd_validate(args) -> int:
 
 def read_input_text(path: Path, limit: int = 50_000_000) -> str:
     """A text input file, or an InputError saying in one line why it cannot be read."""
-    if path.is_dir():
-        raise InputError(f"{path}: is a directory, not a file")
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except OSError as err:
-        raise InputError(f"cannot read {path}: {(err.strerror or str(err)).lower()}") from None
+    data = read_input(path, "a shader file")
     if len(data) > limit:
         raise InputError(f"{path}: larger than {limit} bytes")
     try:

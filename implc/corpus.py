@@ -36,6 +36,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from .errors import ImplcError, InputError, ToolError
+from .fileio import read_input
 from .targets import TARGETS as REGISTRY
 
 TARGETS: tuple[str, ...] = tuple(REGISTRY)  # every target, in the registry's order
@@ -112,14 +113,8 @@ def default_tsv() -> Path | None:
 
 def load_rows(path: Path) -> list[Row]:
     """Read a corpus TSV (the shared one, or a copy with an extra leading `row` column)."""
-    if Path(path).is_dir():
-        raise InputError(f"cannot read {path}: it is a directory, not a corpus TSV")
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(f"cannot read {path}: no such file") from None
-    except OSError as err:
-        raise InputError(f"cannot read {path}: {(err.strerror or str(err)).lower()}") from None
+        text = read_input(path, "a corpus TSV").decode("utf-8")
     except UnicodeDecodeError as err:
         raise InputError(f"{path}: not UTF-8 text (byte {err.start})") from None
     reader = csv.DictReader(text.splitlines(), delimiter="\t")

@@ -22,7 +22,22 @@ import tempfile
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
-from .errors import OutputError
+from .errors import InputError, OutputError
+
+
+def read_input(path: Path, kind: str) -> bytes:
+    """The bytes of an input file, or an InputError saying in one line why it cannot be
+    read; `kind` names what the file should be ("a surface file", "a corpus TSV"). The
+    caller decodes and checks the size, with diagnostics of its own kind."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"cannot read {path}: it is a directory, not {kind}")
+    try:
+        return path.read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"cannot read {path}: no such file") from None
+    except OSError as err:
+        raise InputError(f"cannot read {path}: {(err.strerror or str(err)).lower()}") from None
 
 # errno values that mean "the disk (or the process's file-size limit) is full"
 FULL_DISK = {errno.ENOSPC, errno.EFBIG, getattr(errno, "EDQUOT", errno.ENOSPC)}

@@ -31,6 +31,7 @@ from pathlib import Path
 import sympy
 
 from .errors import InputError, Source
+from .fileio import read_input
 from .parse import Limits, check_param_name, parse_equation_with_params, parse_number
 from .resources import data_dir
 from .scene import View, view_problems
@@ -139,14 +140,7 @@ def _load_toml(
     path: Path, overrides: Mapping[str, sympy.Rational], limits: Limits, origin: str
 ) -> Surface:
     name = str(path)
-    if path.is_dir():
-        raise InputError(f"cannot read {name}: it is a directory, not a surface file")
-    try:
-        raw = path.read_bytes()
-    except FileNotFoundError:
-        raise InputError(f"cannot read {name}: no such file") from None
-    except OSError as err:
-        raise InputError(f"cannot read {name}: {(err.strerror or str(err)).lower()}") from None
+    raw = read_input(path, "a surface file")
     if len(raw) > MAX_FILE_BYTES:
         first = raw[:200].split(b"\n")[0].decode("utf-8", "replace")
         raise InputError(f"file is larger than {MAX_FILE_BYTES} bytes",
