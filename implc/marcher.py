@@ -376,8 +376,9 @@ def _quantities_of(name: str) -> tuple[str, ...]:
 
 def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
     """The ray record's fields and ray_of's body. The polynomial is expanded about the
-    middle of the march interval, sm (F(s) = sum c_k (s - sm)^k, so |s - sm| is at most
-    hr, half the chord): about the entry point its terms would be up to 3^n times larger
+    middle of the march interval: the record's origin is o = ro + sm rd and
+    F(s) = S(o + s d) = sum c_k s^k, so |s| is at most hr, half the chord): about the
+    entry point its terms would be up to 3^n times larger
     for the same sum, and float32 Horner loses that much more to cancellation. `size`,
     sum |c_k| hr^k, bounds the terms of F on the interval: the unit of Horner's rounding
     error in the exact solver's F. Storing the coefficients of F' and F'' as well

@@ -65,7 +65,7 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
-    horner = {"dS": 2 * (degree - 1) + 1, "d2S": 2 * max(degree - 2, 0) + 1}
+    horner = {"dS": 2 * (degree - 1), "d2S": 2 * max(degree - 2, 0)}
     per_step = ", ".join(f"{q} {horner[q]}" for q in dict.fromkeys(quantities))
     point = [" + ".join(qs) for kind, qs in evaluations(method, "ray-poly")
              if kind == "point" and qs not in (("S",), ("grad",))]
@@ -74,7 +74,7 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
         f"ray-poly form (chosen by --eval auto up to degree {AUTO_MAX_DEGREE}):",
         f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
         f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
-        f"  per evaluation, Horner (multiply-adds counted as 2, plus s - sm): "
+        f"  per evaluation, Horner (multiply-adds counted as 2): "
         f"{per_step or 'none'}; F and {', '.join(point) or 'nothing else'} at the point",
     ]
 

@@ -11,8 +11,9 @@
 //   bool  cross_cap_march(vec3 ro, vec3 rd, float t0, float t1, out float t, out int steps)
 //   vec3  cross_cap_shade(vec3 g, vec3 rd)
 //   cross_cap_Ray cross_cap_ray_of(vec3 ro, vec3 rd, float sm, float hr)
-//       the ray record march/intersect use: o, d, the ray polynomial's
-//       coefficients c0..cn of F(s) = S(o + s d) = sum c_k (s - sm)^k and size = sum |c_k| hr^k.
+//       the ray record march/intersect use: o = ro + sm rd (the middle of [sm - hr, sm + hr]),
+//       d, sm, the ray polynomial's coefficients c0..cn of
+//       F(s) = S(o + s d) = sum c_k s^k and size = sum |c_k| hr^k.
 // rd must be unit length; t is measured along rd from ro.
 
 // Method constants (implc compile options).

@@ -13,8 +13,9 @@
 //   bool   miter_march(float3 ro, float3 rd, float t0, float t1, float* t, int* steps)
 //   float3 miter_shade(float3 g, float3 rd)
 //   miter_Ray miter_ray_of(float3 ro, float3 rd, float sm, float hr)
-//       the ray record march/intersect use: o, d, the ray polynomial's
-//       coefficients c0..cn of F(s) = S(o + s d) = sum c_k (s - sm)^k and size = sum |c_k| hr^k.
+//       the ray record march/intersect use: o = ro + sm rd (the middle of [sm - hr, sm + hr]),
+//       d, sm, the ray polynomial's coefficients c0..cn of
+//       F(s) = S(o + s d) = sum c_k s^k and size = sum |c_k| hr^k.
 // rd must be unit length; t is measured along rd from ro; t and steps point to private
 // memory.
 

@@ -11,8 +11,9 @@
 //   fn cross_cap_march(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> cross_cap_Hit
 //   fn cross_cap_shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32>
 //   fn cross_cap_ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> cross_cap_Ray
-//       the ray record march/intersect use: o, d, the ray polynomial's
-//       coefficients c0..cn of F(s) = S(o + s d) = sum c_k (s - sm)^k and size = sum |c_k| hr^k.
+//       the ray record march/intersect use: o = ro + sm rd (the middle of [sm - hr, sm + hr]),
+//       d, sm, the ray polynomial's coefficients c0..cn of
+//       F(s) = S(o + s d) = sum c_k s^k and size = sum |c_k| hr^k.
 // struct cross_cap_Hit { hit: bool, t: f32, steps: i32 }: WGSL has no `out` parameters.
 // rd must be unit length; t is measured along rd from ro.
 
