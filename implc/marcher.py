@@ -483,7 +483,8 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                _horner_err(n, printer, prefix),
                ("real", K + "XTOL", printer.float_literal(constants.xtol)),
                ("real", K + "CTOL", printer.float_literal(constants.ctol)),
-               ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))))
+               ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))),
+               ("int", K + "CRIT_STEPS", str(int(constants.crit_steps))))
     bottom = 2 if n >= 3 else 1
     m = n - bottom
     closed = tuple(printer.doprint(sympy.ff(j + m, m) * c[j + m]) for j in range(bottom + 1))

@@ -26,6 +26,7 @@ const float HORNER_ERR = 9.5367431640625e-07;
 const float XTOL = 1e-06;
 const float CTOL = 0.0003;
 const int NEWTON_STEPS = 12;
+const int CRIT_STEPS = 8;
 
 struct Ray {
     vec3 o;  // origin of the march, s = 0: the point ro + sm rd

@@ -22,6 +22,7 @@ const float CROSS_CAP_HORNER_ERR = 9.5367431640625e-07;
 const float CROSS_CAP_XTOL = 1e-06;
 const float CROSS_CAP_CTOL = 0.0003;
 const int CROSS_CAP_NEWTON_STEPS = 12;
+const int CROSS_CAP_CRIT_STEPS = 8;
 
 struct cross_cap_Ray {
     vec3 o;  // origin of the march, s = 0: the point ro + sm rd

@@ -25,6 +25,7 @@ __constant double HORNER_ERR = 1.7763568394002505e-15;
 __constant double XTOL = 1e-06;
 __constant double CTOL = 0.0003;
 __constant int NEWTON_STEPS = 12;
+__constant int CRIT_STEPS = 8;
 
 typedef struct {
     double3 o;  // origin of the march, s = 0: the point ro + sm rd

@@ -25,6 +25,7 @@ __constant float CROSS_CAP_HORNER_ERR = 9.5367431640625e-07f;
 __constant float CROSS_CAP_XTOL = 1e-06f;
 __constant float CROSS_CAP_CTOL = 0.0003f;
 __constant int CROSS_CAP_NEWTON_STEPS = 12;
+__constant int CROSS_CAP_CRIT_STEPS = 8;
 
 typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd

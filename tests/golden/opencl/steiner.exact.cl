@@ -24,6 +24,7 @@ __constant float HORNER_ERR = 9.5367431640625e-07f;
 __constant float XTOL = 1e-06f;
 __constant float CTOL = 0.0003f;
 __constant int NEWTON_STEPS = 12;
+__constant int CRIT_STEPS = 8;
 
 typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd

@@ -23,6 +23,7 @@ const CROSS_CAP_HORNER_ERR: f32 = 9.5367431640625e-07f;
 const CROSS_CAP_XTOL: f32 = 1e-06f;
 const CROSS_CAP_CTOL: f32 = 0.0003f;
 const CROSS_CAP_NEWTON_STEPS: i32 = 12;
+const CROSS_CAP_CRIT_STEPS: i32 = 8;
 
 struct cross_cap_Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd

@@ -33,6 +33,7 @@ const HORNER_ERR: f32 = 9.5367431640625e-07f;
 const XTOL: f32 = 1e-06f;
 const CTOL: f32 = 0.0003f;
 const NEWTON_STEPS: i32 = 12;
+const CRIT_STEPS: i32 = 8;
 
 struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
