@@ -70,6 +70,8 @@ def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program"
         else:
             result.append(ParamUniform(name, uniform, uniform, value))
     return result
+
+
 PREFIX_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 
 

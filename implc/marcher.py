@@ -163,8 +163,8 @@ class Marcher:
     form: str
     functions: tuple[ShaderFunction, ...]
     constants: tuple[tuple[str, str, str], ...]  # (abstract type, name, printed value)
-    ray_fields: tuple[tuple[str, str, str], ...]  # beyond o and d: (type, name, comment)
-    ray: Code  # lets of ray_of(ro, rd), then the extra fields' values
+    ray_fields: tuple[tuple[str, str, str], ...]  # beyond o, d, sm: (type, name, comment)
+    ray: Code  # lets of ray_of(ro, rd, sm, hr) after oc = ro + sm rd; the fields' values
     sample: Code
     fd: Code
     step: Code
@@ -292,7 +292,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
             return f"{prefix}{_ray_name(quantities)}(ray, {show(arg)})"
         fn = by_name[function_name(quantities)]
         args = [f"ray.o + {at}*ray.d", "ray.d"][: len(fn.params) - len(carried)]
-        args += [f"ray.{name}" for _, name in carried]
+        args += _from_ray(carried)
         return f"{prefix}{fn.name}({', '.join(args)})"
 
     def calls(quantities: tuple[str, ...], arg: sympy.Expr, stem: str, lets: list,
@@ -395,6 +395,11 @@ def _ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
     return fields, Code(tuple(lets), ("size", *(f"c{k}" for k in range(n + 1))))
 
 
+def _from_ray(carried: tuple[tuple[str, str], ...]) -> list[str]:
+    """The carried arguments as a function of the ray reads them: ray.params, ..."""
+    return [f"ray.{name}" for _, name in carried]
+
+
 def _carry(carried: tuple[tuple[str, str], ...], fields: tuple,
            ray: Code) -> tuple[tuple, Code]:
     """The ray record with the carried arguments as fields (ray_of takes them)."""
@@ -414,8 +419,7 @@ def _value_function(name: str, n: int, printer, prefix: str,
                     carried: tuple[tuple[str, str], ...]) -> ShaderFunction:
     """F at u = t - sm, by Horner where its sign is certain, else at the point (see
     RAY_DERIVATIVES)."""
-    extra = "".join(f", ray.{name}" for _, name in carried)
-    at_point = f"{prefix}S(ray.o + u*ray.d{extra})"
+    at_point = f"{prefix}S({', '.join(['ray.o + u*ray.d', *_from_ray(carried)])})"
     certain = f"{printer.doprint(sympy.Abs(_sym('h')))} > {prefix.upper()}HORNER_ERR*ray.size"
     return ShaderFunction(
         name, "F at u = t - sm: Horner's value where its sign is certain, else S at the "

@@ -153,9 +153,8 @@ def test_opencl_uniform_emits_validate(emit_form, method, precision):
     assert verdict.ok, verdict.render(f"kummer-{emit_form}.cl")
 
 
-def _compiled(runner, backend: str):
-    """The runner's compiled object: set_params must keep it."""
-    return {"gl": "program", "wgpu": "pipeline", "cl": "kernel"}[backend]
+# each runner's compiled object: set_params must keep it
+COMPILED = {"gl": "program", "wgpu": "pipeline", "cl": "kernel"}
 
 
 @pytest.mark.parametrize("backend", ["gl", "wgpu", "cl"])
@@ -172,7 +171,7 @@ def test_runner_moves_parameters_without_compiling(backend):
         require_opencl()
     surface = load_surface("torus")
     runner = open_runner(surface, backend, "hessian", hessian(), SIZE, SIZE, params="uniform")
-    compiled = getattr(runner, _compiled(runner, backend))
+    compiled = getattr(runner, COMPILED[backend])
     steps = (({}, []), ({"r": 0.5}, ["r=0.5"]), ({"R": 0.8}, ["R=0.8", "r=0.5"]))
     frames = []
     try:
@@ -180,7 +179,7 @@ def test_runner_moves_parameters_without_compiling(backend):
             if values:
                 runner.set_params(values)
             frames.append(runner.frame())
-        assert getattr(runner, _compiled(runner, backend)) is compiled
+        assert getattr(runner, COMPILED[backend]) is compiled
     finally:
         runner.release()
     for i, ((_, params), frame) in enumerate(zip(steps, frames, strict=True)):

@@ -31,9 +31,6 @@ def _vector3(values, precision: str):
     return make(*(float(v) for v in values))
 
 
-OUTPUT_ARGS = 10  # the kernel's camera, size and clip arguments, then color and aux
-
-
 class ClRunner(TimedRunner):
     """A built program, its kernel and output buffers; `frame()` renders and reads back."""
 
@@ -53,9 +50,8 @@ class ClRunner(TimedRunner):
         nbytes = width * height * 4 * np.dtype(np.float32).itemsize
         self.color = cl.Buffer(dev.context, cl.mem_flags.WRITE_ONLY, nbytes)
         self.aux = cl.Buffer(dev.context, cl.mem_flags.WRITE_ONLY, nbytes)
-        self.real = np.float64 if precision == "double" else np.float32
-        real = self.real
-        self.kernel.set_args(
+        self.real = real = np.float64 if precision == "double" else np.float32
+        args = [
             _vector3(view.eye, precision),
             _vector3(view.target, precision),
             _vector3(view.up, precision),
@@ -66,10 +62,10 @@ class ClRunner(TimedRunner):
             real(view.clip_radius),
             self.color,
             self.aux,
-            *(real(p.value) for p in params),
-        )
-        # --params uniform: parameter i is the kernel argument after aux
-        self.param_index = {p.name: OUTPUT_ARGS + i for i, p in enumerate(params)}
+        ]
+        # --params uniform: the parameters are the kernel arguments after aux
+        self.param_index = {p.name: len(args) + i for i, p in enumerate(params)}
+        self.kernel.set_args(*args, *(real(p.value) for p in params))
 
     def set_params(self, values: Mapping[str, float]) -> None:
         """New parameter values for the next frames (a `--params uniform` program): set

@@ -137,10 +137,10 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
-// The root of P3 in [a, b], where P3 is monotonic and fa0, fb0 are its values at a0, b0
+// The root of P3 in [a0, b0], where P3 is monotonic and fa0, fb are its values at a0, b0
 // (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
 // bracketed by [a, b], a step that leaves it or meets P2 = 0 becomes the midpoint;
-// stops when the step is below CTOL; b when P3 does not change sign on [a, b].
+// stops when the step is below CTOL or after NEWTON_STEPS steps; b when P3 does not change sign.
 
 float root3(Ray ray, float a0, float b0, float fa0, float fb) {
     float a = a0;
@@ -177,10 +177,10 @@ float root3(Ray ray, float a0, float b0, float fa0, float fb) {
     return x;
 }
 
-// The root of P4 in [a, b], where P4 is monotonic and fa0, fb0 are its values at a0, b0
+// The root of P4 in [a0, b0], where P4 is monotonic and fa0, fb are its values at a0, b0
 // (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
 // bracketed by [a, b], a step that leaves it or meets P3 = 0 becomes the midpoint;
-// stops when the step is below XTOL; b when P4 does not change sign on [a, b].
+// stops when the step is below XTOL or after NEWTON_STEPS steps; b when P4 does not change sign.
 
 float root4(Ray ray, float a0, float b0, float fa0, float fb) {
     float a = a0;

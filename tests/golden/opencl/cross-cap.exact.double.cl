@@ -137,10 +137,10 @@ Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
-// The root of P3 in [a, b], where P3 is monotonic and fa0, fb0 are its values at a0, b0
+// The root of P3 in [a0, b0], where P3 is monotonic and fa0, fb are its values at a0, b0
 // (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
 // bracketed by [a, b], a step that leaves it or meets P2 = 0 becomes the midpoint;
-// stops when the step is below CTOL; b when P3 does not change sign on [a, b].
+// stops when the step is below CTOL or after NEWTON_STEPS steps; b when P3 does not change sign.
 
 double root3(Ray ray, double a0, double b0, double fa0, double fb) {
     double a = a0;
@@ -177,10 +177,10 @@ double root3(Ray ray, double a0, double b0, double fa0, double fb) {
     return x;
 }
 
-// The root of P4 in [a, b], where P4 is monotonic and fa0, fb0 are its values at a0, b0
+// The root of P4 in [a0, b0], where P4 is monotonic and fa0, fb are its values at a0, b0
 // (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
 // bracketed by [a, b], a step that leaves it or meets P3 = 0 becomes the midpoint;
-// stops when the step is below XTOL; b when P4 does not change sign on [a, b].
+// stops when the step is below XTOL or after NEWTON_STEPS steps; b when P4 does not change sign.
 
 double root4(Ray ray, double a0, double b0, double fa0, double fb) {
     double a = a0;
