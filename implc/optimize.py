@@ -5,12 +5,17 @@ Three passes, all deterministic:
    temporaries named t0, t1, ... in order of definition);
 2. integer powers to products: x**4 becomes `x_2 = x*x; x_4 = x_2*x_2`, shared across the
    whole function (GLSL/WGSL `pow` is undefined or rejected for negative bases);
-3. op counting with one cost model, before (each output alone, powers as repeated
+3. sums by depth: a sum of three or more terms is added up as a tree that combines the
+   two earliest-ready terms first (depth counted in operations from the inputs), so a
+   term computed late is added last and the sum's dependency chain is as short as the
+   terms allow;
+4. op counting with one cost model, before (each output alone, powers as repeated
    multiplication) and after (the optimized program), so `implc show` can report both.
 """
 
 from __future__ import annotations
 
+import heapq
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -40,6 +45,7 @@ def optimize(outputs: Sequence[sympy.Expr], inputs: Sequence[sympy.Symbol]) -> P
     assignments, reduced = _drop_aliases(assignments, reduced)
     assignments, reduced, powers = _renumber(assignments, reduced, powers)
     assignments = _insert_power_chains(assignments, powers, inputs)
+    assignments, reduced = _sums_by_depth(assignments, reduced, inputs)
     after = sum(count_ops(v) for _, v in assignments) + sum(count_ops(o) for o in reduced)
     return Program(inputs, tuple(assignments), tuple(reduced), before, after)
 
@@ -147,6 +153,49 @@ def _power_chain(base: sympy.Symbol, exponents: set[int]):
     for n in sorted(exponents):
         build(n)
     return chain
+
+
+def _sums_by_depth(assignments, outputs, inputs):
+    """Pass 3: every sum of three or more terms as nested two-term sums (unevaluated, so
+    the printers keep the grouping), the two shallowest terms first, as Huffman's code
+    merges the two lightest. GPU compilers keep the order a sum is written in (floating
+    point addition is not associative), and a march step is bound by its dependency
+    chain: in the Cross-Cap's S, `t0 + (x_2 + z)` instead of `t0 + x_2 + z` made the
+    hessian march as fast as taylor's on llvmpipe (docs/RESULTS.md). Ties keep sympy's
+    canonical order, so the output stays deterministic."""
+    depth: dict[sympy.Basic, int] = dict.fromkeys(inputs, 0)
+
+    def visit(node: sympy.Expr) -> tuple[sympy.Expr, int]:
+        if node.is_Atom:
+            return node, depth.get(node, 0)
+        parts = [visit(a) for a in node.args]
+        if node.is_Add and len(parts) > 2:
+            return _huffman_sum(parts)
+        args = (e for e, _ in parts)
+        # unevaluated: 4*(a + (b + c)) would distribute, a product would flatten a sum
+        rebuilt = node.func(*args, evaluate=False) if node.is_Add or node.is_Mul \
+            else node.func(*args)
+        return rebuilt, max((d for _, d in parts), default=0) + 1
+
+    new_assignments = []
+    for sym, value in assignments:
+        value, depth[sym] = visit(value)
+        new_assignments.append((sym, value))
+    return new_assignments, [visit(o)[0] for o in outputs]
+
+
+def _huffman_sum(parts: list[tuple[sympy.Expr, int]]) -> tuple[sympy.Expr, int]:
+    """The terms' sum as a tree merging the two shallowest first; (sum, its depth)."""
+    heap = [(d, k, e) for k, (e, d) in enumerate(parts)]
+    heapq.heapify(heap)
+    order = len(heap)
+    while len(heap) > 1:
+        da, _, a = heapq.heappop(heap)
+        db, _, b = heapq.heappop(heap)
+        heapq.heappush(heap, (max(da, db) + 1, order, sympy.Add(a, b, evaluate=False)))
+        order += 1
+    depth, _, total = heap[0]
+    return total, depth
 
 
 def count_ops(expr: sympy.Expr) -> int:

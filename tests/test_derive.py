@@ -8,7 +8,7 @@ import pytest
 from cases import EXAMPLES
 
 from implc.derive import Derivatives
-from implc.emit import build_functions, function_quantities
+from implc.emit import build_functions, emit, function_quantities
 from implc.methods import METHODS
 from implc.numeric import evaluate, evaluate_program
 from implc.surface import load_surface
@@ -82,3 +82,31 @@ def test_optimized_program_equals_original(example, method):
                                        err_msg=f"{example}/{name}")
         assert program.ops_after <= program.ops_before, (name, program.ops_before,
                                                          program.ops_after)
+
+
+def test_sums_add_the_latest_term_last():
+    """The Cross-Cap's t0 + x^2 + z, with t0 = y^2 + z^2 two operations deep: x^2 + z is
+    summed while t0 is computed, and t0 comes last (3 operations on the path, not 4)."""
+    import sympy
+
+    from implc.optimize import _sums_by_depth
+
+    x, y, z, t0 = sympy.symbols("x y z t0", real=True)
+    assignments, (out,) = _sums_by_depth([(t0, y * y + z * z)], [t0 + x * x + z], (x, y, z))
+    assert assignments == [(t0, y * y + z * z)]
+    assert len(out.args) == 2 and t0 in out.args, out
+    for target in ("glsl", "wgsl", "opencl"):
+        text = emit(load_surface("cross-cap"), target, "taylor", METHODS["taylor"].defaults)
+        assert "*(t0 + (x_2 + z))" in text, target
+
+@pytest.mark.parametrize("example", EXAMPLES)
+def test_no_sum_of_three_terms_is_printed_flat(example):
+    """Every optimized sum is a tree of two-term sums (the pass of optimize.py that
+    shortens a march step's dependency chain)."""
+    import sympy
+
+    surface = load_surface(example)
+    for name, program in build_functions(surface.expr, METHODS["hessian"]).items():
+        for expr in (*(v for _, v in program.assignments), *program.outputs):
+            flat = [n for n in sympy.preorder_traversal(expr) if n.is_Add and len(n.args) > 2]
+            assert not flat, (example, name, flat[:1])

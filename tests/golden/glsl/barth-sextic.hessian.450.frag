@@ -53,7 +53,7 @@ float S(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = x_2 + y_2 + z_2 - 1.0;
+    float t0 = (x_2 - 1.0) + (y_2 + z_2);
     float t0_2 = t0*t0;
     return -4.23606797749979*t0_2 + 4.0*(-x_2 + 2.6180339887498953*z_2)*(2.6180339887498953*x_2 - y_2)*(2.6180339887498953*y_2 - z_2);
 }
@@ -66,12 +66,12 @@ vec3 grad(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = 16.94427190999916*x_2 + 16.94427190999916*y_2 + 16.94427190999916*z_2 - 16.94427190999916;
+    float t0 = (16.94427190999916*x_2 - 16.94427190999916) + (16.94427190999916*y_2 + 16.94427190999916*z_2);
     float t1 = -x_2 + 2.6180339887498953*z_2;
     float t2 = 2.6180339887498953*y_2 - z_2;
     float t3 = 2.6180339887498953*x_2 - y_2;
     float t4 = 8.0*t3;
-    return vec3(-t0*x + 20.944271909999163*t1*t2*x - t2*t4*x, -t0*y - 8.0*t1*t2*y + 20.944271909999163*t1*t3*y, -t0*z - t1*t4*z + 20.944271909999163*t2*t3*z);
+    return vec3(-t2*t4*x + (-t0*x + 20.944271909999163*t1*t2*x), -t0*y + (-8.0*t1*t2*y + 20.944271909999163*t1*t3*y), -t1*t4*z + (-t0*z + 20.944271909999163*t2*t3*z));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -102,7 +102,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = x_2 + y_2 + z_2 - 1.0;
+    float t0 = (x_2 - 1.0) + (y_2 + z_2);
     float t0_2 = t0*t0;
     float t1 = 2.6180339887498953*y_2 - z_2;
     float t2 = 2.6180339887498953*x_2 - y_2;
@@ -112,26 +112,26 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float t6 = dy*y;
     float t7 = 2.0*t6;
     float t8 = 2.0*dz*z;
-    float t9 = 2.0*t5 + t7 + t8;
+    float t9 = 2.0*t5 + (t7 + t8);
     float t9_2 = t9*t9;
     float t10 = 8.47213595499958*t0;
     float t11 = 5.236067977499791*t6 - t8;
     float t12 = 5.236067977499791*t5 - t7;
     float t13 = 20.944271909999163*dz*z - 8.0*t5;
     float t14 = t12*t3 + t13*t2;
-    float t15 = dx_2 + dy_2 + dz_2;
+    float t15 = dz_2 + (dx_2 + dy_2);
     float t15_2 = t15*t15;
     float t16 = 2.6180339887498953*dy_2 - dz_2;
     float t17 = -4.0*dx_2 + 10.472135954999581*dz_2;
     float t18 = 2.6180339887498953*dx_2 - dy_2;
-    float t19 = t12*t13 + t17*t2 + t18*t3;
+    float t19 = t12*t13 + (t17*t2 + t18*t3);
     float t20 = t12*t17 + t13*t18;
     float t21 = t17*t18;
     float c0 = -4.23606797749979*t0_2 + t1*t4;
-    float c1 = t1*t14 - t10*t9 + t11*t4;
-    float c2 = t1*t19 - t10*t15 + t11*t14 + t16*t4 - 4.23606797749979*t9_2;
-    float c3 = t1*t20 + t11*t19 + t14*t16 - 8.47213595499958*t15*t9;
-    float c4 = t1*t21 + t11*t20 - 4.23606797749979*t15_2 + t16*t19;
+    float c1 = t1*t14 + (-t10*t9 + t11*t4);
+    float c2 = (-4.23606797749979*t9_2 + (-t10*t15 + t16*t4)) + (t1*t19 + t11*t14);
+    float c3 = (t1*t20 - 8.47213595499958*t15*t9) + (t11*t19 + t14*t16);
+    float c4 = t16*t19 + (t11*t20 + (t1*t21 - 4.23606797749979*t15_2));
     float c5 = t11*t21 + t16*t20;
     float c6 = t16*t21;
     float size = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);

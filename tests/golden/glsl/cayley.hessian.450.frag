@@ -50,7 +50,7 @@ float S(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return 16.0*x*y*z + 4.0*x_2 + 4.0*y_2 + 4.0*z_2 - 1.0;
+    return (4.0*x_2 + 4.0*y_2) + (4.0*z_2 + (16.0*x*y*z - 1.0));
 }
 
 // grad at the point p
@@ -95,9 +95,9 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float t2 = 16.0*dy;
     float t3 = dx*t0 + t2*x;
     float t4 = dx*t2;
-    float c0 = t1*z + 4.0*x_2 + 4.0*y_2 + 4.0*z_2 - 1.0;
-    float c1 = 8.0*dx*x + 8.0*dy*y + dz*t1 + 8.0*dz*z + t3*z;
-    float c2 = 4.0*dx_2 + 4.0*dy_2 + dz*t3 + 4.0*dz_2 + t4*z;
+    float c0 = (4.0*y_2 + 4.0*z_2) + (t1*z + (4.0*x_2 - 1.0));
+    float c1 = t3*z + (dz*t1 + (8.0*dz*z + (8.0*dx*x + 8.0*dy*y)));
+    float c2 = (4.0*dz_2 + t4*z) + (dz*t3 + (4.0*dx_2 + 4.0*dy_2));
     float c3 = dz*t4;
     float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);

@@ -50,7 +50,7 @@ float S(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return x_2 + y_2 - z_2*(1.0 - z);
+    return -z_2*(1.0 - z) + (x_2 + y_2);
 }
 
 // grad at the point p
@@ -93,9 +93,9 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dz_3 = dz*dz_2;
     float t0 = 1.0 - z;
     float t1 = 2.0*z;
-    float c0 = -t0*z_2 + x_2 + y_2;
-    float c1 = 2.0*dx*x + 2.0*dy*y - dz*t0*t1 + dz*z_2;
-    float c2 = dx_2 + dy_2 - dz_2*t0 + dz_2*t1;
+    float c0 = -t0*z_2 + (x_2 + y_2);
+    float c1 = -dz*t0*t1 + (dz*z_2 + (2.0*dx*x + 2.0*dy*y));
+    float c2 = -dz_2*t0 + (dz_2*t1 + (dx_2 + dy_2));
     float c3 = dz_3;
     float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);

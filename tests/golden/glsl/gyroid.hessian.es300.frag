@@ -48,7 +48,7 @@ float S(vec3 p) {
     float t0 = 3.0*x;
     float t1 = 3.0*y;
     float t2 = 3.0*z;
-    return cos(t1)*sin(t0) + cos(t2)*sin(t1) + cos(t0)*sin(t2);
+    return (cos(t1)*sin(t0) + cos(t0)*sin(t2)) + cos(t2)*sin(t1);
 }
 
 // grad at the point p
@@ -96,7 +96,7 @@ vec3 SDH(vec3 p, vec3 d) {
     float t14 = 9.0*t4;
     float t15 = 9.0*t11;
     float t16 = 9.0*t8;
-    return vec3(t11 + t4 + t8, dx*(3.0*t10*t3 - t12*t9) + dy*(-t12*t5 + 3.0*t3*t7) + dz*(3.0*t10*t7 - 3.0*t5*t9), dx_2*(-t14 - t15) - 18.0*dy*dz*t3*t9 - dy*t10*t13*t5 + dy_2*(-t14 - t16) - dz*t1*t13*t7 + dz_2*(-t15 - t16));
+    return vec3(t8 + (t11 + t4), dy*(-t12*t5 + 3.0*t3*t7) + (dx*(3.0*t10*t3 - t12*t9) + dz*(3.0*t10*t7 - 3.0*t5*t9)), (dx_2*(-t14 - t15) + (-18.0*dy*dz*t3*t9 + (-dy*t10*t13*t5 - dz*t1*t13*t7))) + (dy_2*(-t14 - t16) + dz_2*(-t15 - t16)));
 }
 
 // S, dS at the point p along the unit direction d
@@ -117,7 +117,7 @@ vec2 SD(vec3 p, vec3 d) {
     float t7 = sin(t5);
     float t8 = cos(t0);
     float t9 = 3.0*t1;
-    return vec2(t1*t3 + t4*t6 + t7*t8, dx*(3.0*t3*t8 - t7*t9) + dy*(3.0*t3*t6 - t4*t9) + dz*(-3.0*t4*t7 + 3.0*t6*t8));
+    return vec2(t7*t8 + (t1*t3 + t4*t6), dy*(3.0*t3*t6 - t4*t9) + (dx*(3.0*t3*t8 - t7*t9) + dz*(-3.0*t4*t7 + 3.0*t6*t8)));
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval

@@ -54,10 +54,10 @@ float S(vec3 p) {
     float y_2 = y*y;
     float z_2 = z*z;
     float z_3 = z*z_2;
-    float t0 = x_2 + 2.25*y_2 + z_2 - 1.0;
+    float t0 = (x_2 - 1.0) + (2.25*y_2 + z_2);
     float t0_2 = t0*t0;
     float t0_3 = t0*t0_2;
-    return t0_3 - x_2*z_3 - 0.1125*y_2*z_3;
+    return t0_3 + (-x_2*z_3 - 0.1125*y_2*z_3);
 }
 
 // grad at the point p
@@ -69,9 +69,9 @@ vec3 grad(vec3 p) {
     float y_2 = y*y;
     float z_2 = z*z;
     float z_3 = z*z_2;
-    float t0 = x_2 + 2.25*y_2 + z_2 - 1.0;
+    float t0 = (x_2 - 1.0) + (2.25*y_2 + z_2);
     float t0_2 = t0*t0;
-    return vec3(6.0*t0_2*x - 2.0*x*z_3, 13.5*t0_2*y - 0.225*y*z_3, 6.0*t0_2*z - 3.0*x_2*z_2 - 0.3375*y_2*z_2);
+    return vec3(6.0*t0_2*x - 2.0*x*z_3, 13.5*t0_2*y - 0.225*y*z_3, 6.0*t0_2*z + (-3.0*x_2*z_2 - 0.3375*y_2*z_2));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -105,7 +105,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dz_2 = dz*dz;
     float dz_3 = dz*dz_2;
     float t0 = 0.1125*z_3;
-    float t1 = x_2 + 2.25*y_2 + z_2 - 1.0;
+    float t1 = (x_2 - 1.0) + (2.25*y_2 + z_2);
     float t1_2 = t1*t1;
     float t1_3 = t1*t1_2;
     float t2 = dx*x;
@@ -115,24 +115,24 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float t6 = dz*z_2;
     float t7 = 3.0*x_2;
     float t8 = 0.3375*y_2;
-    float t9 = 2.0*dz*z + t3 + 4.5*t4;
+    float t9 = 4.5*t4 + (2.0*dz*z + t3);
     float t9_2 = t9*t9;
     float t10 = 6.0*t2;
     float t11 = 0.675*t4;
     float t12 = dz_2*z;
-    float t13 = dx_2 + 2.25*dy_2 + dz_2;
+    float t13 = 2.25*dy_2 + (dx_2 + dz_2);
     float t13_2 = t13*t13;
     float t13_3 = t13*t13_2;
     float t14 = 2.0*t1*t13 + t9_2;
     float t15 = 0.1125*dz_3;
     float t16 = 3.0*dx_2;
     float t17 = 0.3375*dy_2;
-    float c0 = -t0*y_2 + t1_3 - x_2*z_3;
-    float c1 = 3.0*t1_2*t9 - t3*z_3 - t5*z_3 - t6*t7 - t6*t8;
-    float c2 = -dx_2*z_3 - dy_2*t0 + t1*t14 + 2.0*t1*t9_2 - t10*t6 - t11*t6 - t12*t7 - t12*t8 + t13*t1_2;
-    float c3 = -dz_3*x_2 + 4.0*t1*t13*t9 - t10*t12 - t11*t12 + t14*t9 - t15*y_2 - t16*t6 - t17*t6;
-    float c4 = -dz_3*t3 - dz_3*t5 + t1*t13_2 - t12*t16 - t12*t17 + t13*t14 + 2.0*t13*t9_2;
-    float c5 = -dx_2*dz_3 - dy_2*t15 + 3.0*t13_2*t9;
+    float c0 = t1_3 + (-t0*y_2 - x_2*z_3);
+    float c1 = 3.0*t1_2*t9 + ((-t3*z_3 - t5*z_3) + (-t6*t7 - t6*t8));
+    float c2 = (t1*t14 + ((-dy_2*t0 - t12*t8) + ((-dx_2*z_3 - t10*t6) + (-t11*t6 - t12*t7)))) + (2.0*t1*t9_2 + t13*t1_2);
+    float c3 = t14*t9 + ((4.0*t1*t13*t9 + (-t15*y_2 - t17*t6)) + ((-dz_3*x_2 - t10*t12) + (-t11*t12 - t16*t6)));
+    float c4 = t13*t14 + (2.0*t13*t9_2 + (t1*t13_2 + ((-dz_3*t3 - dz_3*t5) + (-t12*t16 - t12*t17))));
+    float c5 = 3.0*t13_2*t9 + (-dx_2*dz_3 - dy_2*t15);
     float c6 = t13_3;
     float size = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);

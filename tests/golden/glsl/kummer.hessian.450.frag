@@ -55,9 +55,9 @@ float S(vec3 p) {
     float t1 = t0*y;
     float t2 = z + 1.0;
     float t3 = t0*x;
-    float t4 = x_2 + y_2 + z_2 - 1.3;
+    float t4 = (x_2 - 1.3) + (y_2 + z_2);
     float t4_2 = t4*t4;
-    return t4_2 - 1.7058823529411766*(t1 + t2)*(-t1 + t2)*(t3 - z + 1.0)*(-t3 - z + 1.0);
+    return t4_2 - 1.7058823529411766*(t1 + t2)*(-t1 + t2)*(t3 + (1.0 - z))*(-t3 + (1.0 - z));
 }
 
 // grad at the point p
@@ -68,22 +68,22 @@ vec3 grad(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = 4.0*x_2 + 4.0*y_2 + 4.0*z_2 - 5.2;
+    float t0 = (4.0*x_2 - 5.2) + (4.0*y_2 + 4.0*z_2);
     float t1 = 1.4142135623730951;
     float t2 = t1*x;
-    float t3 = t2 - z + 1.0;
+    float t3 = t2 + (1.0 - z);
     float t4 = t1*y;
     float t5 = z + 1.0;
     float t6 = t4 + t5;
     float t7 = -t4 + t5;
     float t8 = 1.7058823529411766*t6*t7;
     float t9 = t3*t8;
-    float t10 = -t2 - z + 1.0;
+    float t10 = -t2 + (1.0 - z);
     float t11 = t10*t8;
     float t12 = 1.7058823529411766*t10*t3;
     float t13 = t12*t6;
     float t14 = t12*t7;
-    return vec3(t0*x - t1*t11 + t1*t9, t0*y + t1*t13 - t1*t14, t0*z + t11 - t13 - t14 + t9);
+    return vec3(-t1*t11 + (t0*x + t1*t9), -t1*t14 + (t0*y + t1*t13), (-t13 + t9) + (-t14 + (t0*z + t11)));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -114,18 +114,18 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = x_2 + y_2 + z_2 - 1.3;
+    float t0 = (x_2 - 1.3) + (y_2 + z_2);
     float t0_2 = t0*t0;
     float t1 = 1.4142135623730951;
     float t2 = t1*x;
-    float t3 = -t2 - z + 1.0;
-    float t4 = t2 - z + 1.0;
+    float t3 = -t2 + (1.0 - z);
+    float t4 = t2 + (1.0 - z);
     float t5 = t1*y;
-    float t6 = -1.7058823529411766*t5 - 1.7058823529411766*z - 1.7058823529411766;
-    float t7 = -t5 + z + 1.0;
+    float t6 = -1.7058823529411766*t5 + (-1.7058823529411766*z - 1.7058823529411766);
+    float t7 = -t5 + (z + 1.0);
     float t8 = t6*t7;
     float t9 = t4*t8;
-    float t10 = 2.0*dx*x + 2.0*dy*y + 2.0*dz*z;
+    float t10 = 2.0*dz*z + (2.0*dx*x + 2.0*dy*y);
     float t10_2 = t10*t10;
     float t11 = 2.0*t0;
     float t12 = dx*t1;
@@ -137,15 +137,15 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float t18 = -t14 - t16;
     float t19 = t17*t7 + t18*t6;
     float t20 = t15*t8 + t19*t4;
-    float t21 = dx_2 + dy_2 + dz_2;
+    float t21 = dz_2 + (dx_2 + dy_2);
     float t21_2 = t21*t21;
     float t22 = t17*t18;
     float t23 = t15*t19 + t22*t4;
     float t24 = t15*t22;
     float c0 = t0_2 + t3*t9;
-    float c1 = t10*t11 + t13*t9 + t20*t3;
-    float c2 = t10_2 + t11*t21 + t13*t20 + t23*t3;
-    float c3 = 2.0*t10*t21 + t13*t23 + t24*t3;
+    float c1 = t20*t3 + (t10*t11 + t13*t9);
+    float c2 = t23*t3 + (t13*t20 + (t10_2 + t11*t21));
+    float c3 = t13*t23 + (2.0*t10*t21 + t24*t3);
     float c4 = t13*t24 + t21_2;
     float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);

@@ -51,7 +51,7 @@ float S(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return -x*y*z + x_2*y_2 + x_2*z_2 + y_2*z_2;
+    return (x_2*z_2 + y_2*z_2) + (-x*y*z + x_2*y_2);
 }
 
 // grad at the point p
@@ -65,7 +65,7 @@ vec3 grad(vec3 p) {
     float t0 = 2.0*x;
     float t1 = 2.0*y;
     float t2 = 2.0*z;
-    return vec3(t0*y_2 + t0*z_2 - y*z, t1*x_2 + t1*z_2 - x*z, t2*x_2 + t2*y_2 - x*y);
+    return vec3(t0*z_2 + (t0*y_2 - y*z), t1*z_2 + (t1*x_2 - x*z), t2*y_2 + (t2*x_2 - x*y));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -111,11 +111,11 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float t12 = 2.0*t2;
     float t13 = 2.0*t4;
     float t14 = 2.0*t6;
-    float c0 = -t0*z + x_2*y_2 + x_2*z_2 + y_2*z_2;
-    float c1 = -dz*t0 + t1*t2 + t1*t6 + t2*t3 + t3*t4 + t4*t5 + t5*t6 + t9*z;
-    float c2 = dx_2*y_2 + dx_2*z_2 + dy_2*x_2 + dy_2*z_2 + dz*t9 + dz_2*x_2 + dz_2*y_2 - t10*z + t11*t2 + t11*t4 + 4.0*t7*t8;
-    float c3 = dx_2*t13 + dx_2*t14 + dy_2*t12 + dy_2*t14 - dz*t10 + dz_2*t12 + dz_2*t13;
-    float c4 = dx_2*dy_2 + dx_2*dz_2 + dy_2*dz_2;
+    float c0 = (-t0*z + y_2*z_2) + (x_2*y_2 + x_2*z_2);
+    float c1 = ((-dz*t0 + t1*t2) + (t1*t6 + t2*t3)) + ((t3*t4 + t4*t5) + (t5*t6 + t9*z));
+    float c2 = (dz*t9 + (t11*t2 + t11*t4)) + (((dx_2*y_2 + dx_2*z_2) + (dy_2*x_2 + dy_2*z_2)) + ((dz_2*x_2 + dz_2*y_2) + (-t10*z + 4.0*t7*t8)));
+    float c3 = (dz_2*t13 + (dx_2*t13 - dz*t10)) + ((dx_2*t14 + dy_2*t12) + (dy_2*t14 + dz_2*t12));
+    float c4 = dy_2*dz_2 + (dx_2*dy_2 + dx_2*dz_2);
     float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }

@@ -49,7 +49,7 @@ float S(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return x_2 + y_2 + z_2 - 1.0;
+    return (x_2 - 1.0) + (y_2 + z_2);
 }
 
 // grad at the point p
@@ -88,9 +88,9 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float c0 = x_2 + y_2 + z_2 - 1.0;
-    float c1 = 2.0*dx*x + 2.0*dy*y + 2.0*dz*z;
-    float c2 = dx_2 + dy_2 + dz_2;
+    float c0 = (x_2 - 1.0) + (y_2 + z_2);
+    float c1 = 2.0*dz*z + (2.0*dx*x + 2.0*dy*y);
+    float c2 = dz_2 + (dx_2 + dy_2);
     float size = hr*(hr*abs(c2) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2);
 }

@@ -50,7 +50,7 @@ float steiner_S(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return -x*y*z + x_2*y_2 - x_2*z_2 + y_2*z_2;
+    return (-x_2*z_2 + y_2*z_2) + (-x*y*z + x_2*y_2);
 }
 
 // grad at the point p
@@ -62,7 +62,7 @@ vec3 steiner_grad(vec3 p) {
     float y_2 = y*y;
     float z_2 = z*z;
     float t0 = 2.0*y;
-    return vec3(2.0*x*y_2 - 2.0*x*z_2 - y*z, t0*x_2 + t0*z_2 - x*z, -x*y - 2.0*x_2*z + 2.0*y_2*z);
+    return vec3(2.0*x*y_2 + (-2.0*x*z_2 - y*z), t0*z_2 + (t0*x_2 - x*z), 2.0*y_2*z + (-x*y - 2.0*x_2*z));
 }
 
 // dS at march parameter s: Horner on the ray polynomial
@@ -102,11 +102,11 @@ steiner_Ray steiner_ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float t11 = 4.0*t6;
     float t12 = 2.0*t1;
     float t13 = 2.0*dx_2;
-    float c0 = -t0*z + x_2*y_2 - x_2*z_2 + y_2*z_2;
-    float c1 = -dz*t0 + t1*t2 - t1*t3 + t2*t6 + t3*t5 + t4*t5 - t4*t6 + t9*z;
-    float c2 = dx_2*y_2 - dx_2*z_2 + dy_2*x_2 + dy_2*z_2 + dz*t9 - dz_2*x_2 + dz_2*y_2 - t1*t11 - t10*z + t11*t5 + 4.0*t7*t8;
-    float c3 = dy_2*t12 + 2.0*dy_2*t6 - dz*t10 - dz_2*t12 + 2.0*dz_2*t5 + t13*t5 - t13*t6;
-    float c4 = dx_2*dy_2 - dx_2*dz_2 + dy_2*dz_2;
+    float c0 = (-t0*z - x_2*z_2) + (x_2*y_2 + y_2*z_2);
+    float c1 = ((-dz*t0 + t1*t2) + (t2*t6 + t3*t5)) + ((-t1*t3 + t4*t5) + (-t4*t6 + t9*z));
+    float c2 = (dz*t9 + (-t1*t11 + t11*t5)) + (((dx_2*y_2 + dy_2*x_2) + (dy_2*z_2 + dz_2*y_2)) + ((-dx_2*z_2 - dz_2*x_2) + (-t10*z + 4.0*t7*t8)));
+    float c3 = (-t13*t6 + (2.0*dy_2*t6 - dz*t10)) + ((dy_2*t12 + 2.0*dz_2*t5) + (-dz_2*t12 + t13*t5));
+    float c4 = -dx_2*dz_2 + (dx_2*dy_2 + dy_2*dz_2);
     float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return steiner_Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }

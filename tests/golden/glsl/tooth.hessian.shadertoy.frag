@@ -42,7 +42,7 @@ float S(vec3 p) {
     float y_4 = y_2*y_2;
     float z_2 = z*z;
     float z_4 = z_2*z_2;
-    return -x_2 + x_4 - y_2 + y_4 - z_2 + z_4;
+    return (-y_2 - z_2) + ((-x_2 + z_4) + (x_4 + y_4));
 }
 
 // grad at the point p
@@ -99,11 +99,11 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dz_2 = dz*dz;
     float dz_3 = dz*dz_2;
     float dz_4 = dz_2*dz_2;
-    float c0 = -x_2 + x_4 - y_2 + y_4 - z_2 + z_4;
-    float c1 = -2.0*dx*x + 4.0*dx*x_3 - 2.0*dy*y + 4.0*dy*y_3 - 2.0*dz*z + 4.0*dz*z_3;
-    float c2 = 6.0*dx_2*x_2 - dx_2 + 6.0*dy_2*y_2 - dy_2 + 6.0*dz_2*z_2 - dz_2;
-    float c3 = 4.0*dx_3*x + 4.0*dy_3*y + 4.0*dz_3*z;
-    float c4 = dx_4 + dy_4 + dz_4;
+    float c0 = (-y_2 - z_2) + ((-x_2 + z_4) + (x_4 + y_4));
+    float c1 = (4.0*dx*x_3 + 4.0*dy*y_3) + (4.0*dz*z_3 + (-2.0*dz*z + (-2.0*dx*x - 2.0*dy*y)));
+    float c2 = (6.0*dy_2*y_2 + 6.0*dz_2*z_2) + ((-dx_2 - dy_2) + (6.0*dx_2*x_2 - dz_2));
+    float c3 = 4.0*dz_3*z + (4.0*dx_3*x + 4.0*dy_3*y);
+    float c4 = dz_4 + (dx_4 + dy_4);
     float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }

@@ -39,9 +39,9 @@ float S(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = x_2 + y_2 + z_2 + 0.8775;
+    float t0 = (x_2 + 0.8775) + (y_2 + z_2);
     float t0_2 = t0*t0;
-    return t0_2 - 4.0*x_2 - 4.0*y_2;
+    return t0_2 + (-4.0*x_2 - 4.0*y_2);
 }
 
 // grad at the point p
@@ -52,7 +52,7 @@ vec3 grad(vec3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = 4.0*x_2 + 4.0*y_2 + 4.0*z_2 + 3.51;
+    float t0 = (4.0*x_2 + 3.51) + (4.0*y_2 + 4.0*z_2);
     return vec3(t0*x - 8.0*x, t0*y - 8.0*y, t0*z);
 }
 
@@ -84,17 +84,17 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = x_2 + y_2 + z_2 + 0.8775;
+    float t0 = (x_2 + 0.8775) + (y_2 + z_2);
     float t0_2 = t0*t0;
     float t1 = dx*x;
     float t2 = dy*y;
-    float t3 = 2.0*dz*z + 2.0*t1 + 2.0*t2;
+    float t3 = 2.0*t2 + (2.0*dz*z + 2.0*t1);
     float t3_2 = t3*t3;
-    float t4 = dx_2 + dy_2 + dz_2;
+    float t4 = dz_2 + (dx_2 + dy_2);
     float t4_2 = t4*t4;
-    float c0 = t0_2 - 4.0*x_2 - 4.0*y_2;
-    float c1 = 2.0*t0*t3 - 8.0*t1 - 8.0*t2;
-    float c2 = -4.0*dx_2 - 4.0*dy_2 + 2.0*t0*t4 + t3_2;
+    float c0 = t0_2 + (-4.0*x_2 - 4.0*y_2);
+    float c1 = 2.0*t0*t3 + (-8.0*t1 - 8.0*t2);
+    float c2 = t3_2 + (2.0*t0*t4 + (-4.0*dx_2 - 4.0*dy_2));
     float c3 = 2.0*t3*t4;
     float c4 = t4_2;
     float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);

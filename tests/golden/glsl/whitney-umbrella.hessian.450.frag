@@ -89,8 +89,8 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float dy_2 = dy*dy;
     float t0 = 2.0*dy*y;
     float c0 = x_2 - y_2*z;
-    float c1 = 2.0*dx*x - dz*y_2 - t0*z;
-    float c2 = dx_2 - dy_2*z - dz*t0;
+    float c1 = -t0*z + (2.0*dx*x - dz*y_2);
+    float c2 = -dz*t0 + (dx_2 - dy_2*z);
     float c3 = -dy_2*dz;
     float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);

@@ -57,7 +57,7 @@ float S(float3 p) {
     float t4_2 = t4*t4;
     float t5 = y + 0.3f;
     float t5_2 = t5*t5;
-    return -exp(-t0 - 4.0f*t1_2 - 4.0f*y_2) - exp(-t0 - 4.0f*t2_2 - 4.0f*t3_2) - exp(-4.0f*t4_2 - 4.0f*t5_2 - 4.0f*x_2) + 0.6f;
+    return (0.6f - exp(-4.0f*t1_2 + (-t0 - 4.0f*y_2))) + (-exp(-4.0f*t3_2 + (-t0 - 4.0f*t2_2)) - exp(-4.0f*t5_2 + (-4.0f*t4_2 - 4.0f*x_2)));
 }
 
 // grad at the point p
@@ -72,20 +72,20 @@ float3 grad(float3 p) {
     float t0_2 = t0*t0;
     float t1 = y + 0.3f;
     float t1_2 = t1*t1;
-    float t2 = exp(-4.0f*t0_2 - 4.0f*t1_2 - 4.0f*x_2);
+    float t2 = exp(-4.0f*t1_2 + (-4.0f*t0_2 - 4.0f*x_2));
     float t3 = 8.0f*x;
     float t4 = 4.0f*z_2;
     float t5 = x - 0.5f;
     float t5_2 = t5*t5;
-    float t6 = exp(-t4 - 4.0f*t5_2 - 4.0f*y_2);
+    float t6 = exp(-4.0f*t5_2 + (-t4 - 4.0f*y_2));
     float t7 = y - 0.4f;
     float t7_2 = t7*t7;
     float t8 = x + 0.4f;
     float t8_2 = t8*t8;
-    float t9 = exp(-t4 - 4.0f*t7_2 - 4.0f*t8_2);
+    float t9 = exp(-4.0f*t8_2 + (-t4 - 4.0f*t7_2));
     float t10 = 8.0f*y;
     float t11 = 8.0f*z;
-    return (float3)(8.0f*t2*x - t6*(4.0f - t3) - t9*(-t3 - 3.2f), -t2*(-t10 - 2.4f) + 8.0f*t6*y - t9*(3.2f - t10), t11*t6 + t11*t9 - t2*(4.0f - t11));
+    return (float3)(8.0f*t2*x + (-t6*(4.0f - t3) - t9*(-t3 - 3.2f)), 8.0f*t6*y + (-t2*(-t10 - 2.4f) - t9*(3.2f - t10)), -t2*(4.0f - t11) + (t11*t6 + t11*t9));
 }
 
 // S, dS, d2S at the point p along the unit direction d
@@ -105,17 +105,17 @@ float3 SDH(float3 p, float3 d) {
     float t0 = 4.0f*z_2;
     float t1 = x - 0.5f;
     float t1_2 = t1*t1;
-    float t2 = exp(-t0 - 4.0f*t1_2 - 4.0f*y_2);
+    float t2 = exp(-4.0f*t1_2 + (-t0 - 4.0f*y_2));
     float t3 = z - 0.5f;
     float t3_2 = t3*t3;
     float t4 = y + 0.3f;
     float t4_2 = t4*t4;
-    float t5 = exp(-4.0f*t3_2 - 4.0f*t4_2 - 4.0f*x_2);
+    float t5 = exp(-4.0f*t4_2 + (-4.0f*t3_2 - 4.0f*x_2));
     float t6 = y - 0.4f;
     float t6_2 = t6*t6;
     float t7 = x + 0.4f;
     float t7_2 = t7*t7;
-    float t8 = exp(-t0 - 4.0f*t6_2 - 4.0f*t7_2);
+    float t8 = exp(-4.0f*t7_2 + (-t0 - 4.0f*t6_2));
     float t9 = 8.0f*z;
     float t10 = 4.0f - t9;
     float t10_2 = t10*t10;
@@ -135,8 +135,8 @@ float3 SDH(float3 p, float3 d) {
     float t20 = t19*t5;
     float t21 = 2.0f*dx;
     float t22 = 64.0f*t2;
-    float t23 = -8.0f*t2 - 8.0f*t5 - 8.0f*t8;
-    return (float3)(-t2 - t5 - t8 + 0.6f, dx*(-t14 - t16 + 8.0f*t5*x) + dy*(-t18*t8 + 8.0f*t2*y - t20) + dz*(-t11 + t2*t9 + t8*t9), dx_2*(-t13_2*t2 - t15_2*t8 - t23 - 64.0f*t5*x_2) + 2.0f*dy*dz*(-t10*t20 + 8.0f*t18*t8*z - t22*y*z) + dy*t21*(t12*t20 + t14*t17 - t16*t18) + dy_2*(-t18_2*t8 - t19_2*t5 - t22*y_2 - t23) + dz*t21*(t11*t12 + t14*t9 + t16*t9) + dz_2*(-t10_2*t5 - t22*z_2 - t23 - 64.0f*t8*z_2));
+    float t23 = -8.0f*t8 + (-8.0f*t2 - 8.0f*t5);
+    return (float3)((0.6f - t2) + (-t5 - t8), dx*(-t16 + (-t14 + 8.0f*t5*x)) + (dy*(-t20 + (-t18*t8 + 8.0f*t2*y)) + dz*(-t11 + (t2*t9 + t8*t9))), (dy_2*(-t23 + (-t22*y_2 + (-t18_2*t8 - t19_2*t5))) + dz_2*(-t23 + (-t22*z_2 + (-t10_2*t5 - 64.0f*t8*z_2)))) + ((dx_2*(-t23 + (-64.0f*t5*x_2 + (-t13_2*t2 - t15_2*t8))) + 2.0f*dy*dz*(-t22*y*z + (-t10*t20 + 8.0f*t18*t8*z))) + (dy*t21*(-t16*t18 + (t12*t20 + t14*t17)) + dz*t21*(t16*t9 + (t11*t12 + t14*t9)))));
 }
 
 // S, dS at the point p along the unit direction d
@@ -153,21 +153,21 @@ float2 SD(float3 p, float3 d) {
     float t0 = 4.0f*z_2;
     float t1 = x - 0.5f;
     float t1_2 = t1*t1;
-    float t2 = exp(-t0 - 4.0f*t1_2 - 4.0f*y_2);
+    float t2 = exp(-4.0f*t1_2 + (-t0 - 4.0f*y_2));
     float t3 = z - 0.5f;
     float t3_2 = t3*t3;
     float t4 = y + 0.3f;
     float t4_2 = t4*t4;
-    float t5 = exp(-4.0f*t3_2 - 4.0f*t4_2 - 4.0f*x_2);
+    float t5 = exp(-4.0f*t4_2 + (-4.0f*t3_2 - 4.0f*x_2));
     float t6 = y - 0.4f;
     float t6_2 = t6*t6;
     float t7 = x + 0.4f;
     float t7_2 = t7*t7;
-    float t8 = exp(-t0 - 4.0f*t6_2 - 4.0f*t7_2);
+    float t8 = exp(-4.0f*t7_2 + (-t0 - 4.0f*t6_2));
     float t9 = 8.0f*z;
     float t10 = 8.0f*x;
     float t11 = 8.0f*y;
-    return (float2)(-t2 - t5 - t8 + 0.6f, dx*(-t2*(4.0f - t10) + 8.0f*t5*x - t8*(-t10 - 3.2f)) + dy*(8.0f*t2*y - t5*(-t11 - 2.4f) - t8*(3.2f - t11)) + dz*(t2*t9 - t5*(4.0f - t9) + t8*t9));
+    return (float2)((0.6f - t2) + (-t5 - t8), dz*(-t5*(4.0f - t9) + (t2*t9 + t8*t9)) + (dx*(8.0f*t5*x + (-t2*(4.0f - t10) - t8*(-t10 - 3.2f))) + dy*(8.0f*t2*y + (-t5*(-t11 - 2.4f) - t8*(3.2f - t11)))));
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval

@@ -51,7 +51,7 @@ float S(float3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return 16.0f*x*y*z + 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 - 1.0f;
+    return (4.0f*x_2 + 4.0f*y_2) + (4.0f*z_2 + (16.0f*x*y*z - 1.0f));
 }
 
 // grad at the point p
@@ -96,9 +96,9 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float t2 = 16.0f*dy;
     float t3 = dx*t0 + t2*x;
     float t4 = dx*t2;
-    float c0 = t1*z + 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 - 1.0f;
-    float c1 = 8.0f*dx*x + 8.0f*dy*y + dz*t1 + 8.0f*dz*z + t3*z;
-    float c2 = 4.0f*dx_2 + 4.0f*dy_2 + dz*t3 + 4.0f*dz_2 + t4*z;
+    float c0 = (4.0f*y_2 + 4.0f*z_2) + (t1*z + (4.0f*x_2 - 1.0f));
+    float c1 = t3*z + (dz*t1 + (8.0f*dz*z + (8.0f*dx*x + 8.0f*dy*y)));
+    float c2 = (4.0f*dz_2 + t4*z) + (dz*t3 + (4.0f*dx_2 + 4.0f*dy_2));
     float c3 = dz*t4;
     float size = hr*(hr*(hr*fabs(c3) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3};

@@ -57,7 +57,7 @@ float S(float3 p) {
     float t0 = 189.0f*x;
     float t1 = 189.0f*y;
     float t2 = 189.0f*z;
-    return -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f;
+    return (((-9.0f*x_2 - 9.0f*y_2) + (-t0*y_2 - 9.0f*z_2)) + ((-t0*z_2 - t1*x_2) + (-t1*z_2 - t2*x_2))) + (((81.0f*x_3 + (54.0f*x*y*z + 126.0f*y*z)) + (81.0f*y_3 + 81.0f*z_3)) + ((-t2*y_2 + (1.0f - 9.0f*x)) + ((-9.0f*y - 9.0f*z) + (126.0f*x*y + 126.0f*x*z))));
 }
 
 // grad at the point p
@@ -69,10 +69,10 @@ float3 grad(float3 p) {
     float y_2 = y*y;
     float z_2 = z*z;
     float t0 = 378.0f*x;
-    float t1 = t0*y - 126.0f*z + 189.0f*z_2 + 9.0f;
-    float t2 = t0*z - 126.0f*y + 189.0f*y_2;
-    float t3 = -126.0f*x + 189.0f*x_2 + 378.0f*y*z;
-    return (float3)(-t1 - t2 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z, -t1 - t3 + 54.0f*x*z - 18.0f*y + 243.0f*y_2, -t2 - t3 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f);
+    float t1 = (9.0f - 126.0f*z) + (t0*y + 189.0f*z_2);
+    float t2 = t0*z + (-126.0f*y + 189.0f*y_2);
+    float t3 = 189.0f*x_2 + (-126.0f*x + 378.0f*y*z);
+    return (float3)(-t2 + (-t1 + (243.0f*x_2 + (-18.0f*x + 54.0f*y*z))), -t1 + (-t3 + (243.0f*y_2 + (54.0f*x*z - 18.0f*y))), -t2 + (-t3 + ((-18.0f*z - 9.0f) + (54.0f*x*y + 243.0f*z_2))));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -124,10 +124,10 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float t12 = 189.0f*dy;
     float t13 = 189.0f*dz;
     float t14 = 54.0f*dx*y + 54.0f*t7;
-    float c0 = -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f;
-    float c1 = 243.0f*dx*x_2 + 126.0f*dx*y + 126.0f*dx*z - 9.0f*dx + 126.0f*dy*x + 243.0f*dy*y_2 + 126.0f*dy*z - 9.0f*dy + 54.0f*dz*x*y + 126.0f*dz*x + 126.0f*dz*y + 243.0f*dz*z_2 - 9.0f*dz - t10*x - t11*y_2 - t11*z_2 - t12*x_2 - t12*z_2 - t13*x_2 - t13*y_2 + t14*z - 18.0f*t3 - 18.0f*t4 - t5*t8 - 18.0f*t5 - t6*y - t6*z - t7*t8 - t9*z;
-    float c2 = 54.0f*dx*dy*z + 126.0f*dx*dy + 126.0f*dx*dz - dx*t10 - 378.0f*dx*t7 - dx*t9 - dx_2*t1 - dx_2*t2 + 243.0f*dx_2*x - 9.0f*dx_2 + 126.0f*dy*dz - dy*t10 - dy_2*t0 - dy_2*t2 + 243.0f*dy_2*y - 9.0f*dy_2 + dz*t14 - dz*t6 - dz*t9 - dz_2*t0 - dz_2*t1 + 243.0f*dz_2*z - 9.0f*dz_2;
-    float c3 = 54.0f*dx*dy*dz - dx_2*t12 - dx_2*t13 + 81.0f*dx_3 - dy_2*t11 - dy_2*t13 + 81.0f*dy_3 - dz_2*t11 - dz_2*t12 + 81.0f*dz_3;
+    float c0 = (((-9.0f*x_2 - 9.0f*y_2) + (-t0*y_2 - 9.0f*z_2)) + ((-t0*z_2 - t1*x_2) + (-t1*z_2 - t2*x_2))) + (((81.0f*x_3 + (54.0f*x*y*z + 126.0f*y*z)) + (81.0f*y_3 + 81.0f*z_3)) + ((-t2*y_2 + (1.0f - 9.0f*x)) + ((-9.0f*y - 9.0f*z) + (126.0f*x*y + 126.0f*x*z))));
+    float c1 = ((t14*z + (-t10*x + (54.0f*dz*x*y + 126.0f*dz*y))) + ((-t6*y - t6*z) + (-t9*z + (-18.0f*t3 - 18.0f*t4)))) + ((((243.0f*dx*x_2 - t7*t8) + (243.0f*dy*y_2 + 243.0f*dz*z_2)) + (((-9.0f*dx - 9.0f*dy) + (126.0f*dx*y - 9.0f*dz)) + ((126.0f*dx*z + 126.0f*dy*x) + (126.0f*dy*z + 126.0f*dz*x)))) + (((-t11*y_2 - 18.0f*t5) + (-t11*z_2 - t12*x_2)) + ((-t12*z_2 - t13*x_2) + (-t13*y_2 - t5*t8))));
+    float c2 = ((dz*t14 + (243.0f*dz_2*z + (126.0f*dx*dy + 126.0f*dx*dz))) + ((-dx*t10 + (54.0f*dx*dy*z + 126.0f*dy*dz)) + (-dx*t9 - dy*t10))) + (((-dz*t6 - dz*t9) + ((-9.0f*dx_2 - 9.0f*dy_2) + (-dx_2*t1 - 9.0f*dz_2))) + (((-378.0f*dx*t7 - dz_2*t1) + (243.0f*dx_2*x + 243.0f*dy_2*y)) + ((-dx_2*t2 - dy_2*t0) + (-dy_2*t2 - dz_2*t0))));
+    float c3 = ((81.0f*dx_3 - dz_2*t12) + (-dy_2*t13 - dz_2*t11)) + ((81.0f*dy_3 + 81.0f*dz_3) + ((-dx_2*t13 - dy_2*t11) + (54.0f*dx*dy*dz - dx_2*t12)));
     float size = hr*(hr*(hr*fabs(c3) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3};
 }

@@ -53,7 +53,7 @@ float S(float3 p) {
     float y_2 = y*y;
     float z_2 = z*z;
     float t0 = y_2 + z_2;
-    return 4.0f*x_2*(t0 + x_2 + z) + y_2*(t0 - 1.0f);
+    return 4.0f*x_2*(t0 + (x_2 + z)) + y_2*(t0 - 1.0f);
 }
 
 // grad at the point p
@@ -68,7 +68,7 @@ float3 grad(float3 p) {
     float z_2 = z*z;
     float t0 = y_2 + z_2;
     float t1 = 2.0f*z;
-    return (float3)(8.0f*x*(t0 + x_2 + z) + 8.0f*x_3, 8.0f*x_2*y + 2.0f*y*(t0 - 1.0f) + 2.0f*y_3, t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
+    return (float3)(8.0f*x*(t0 + (x_2 + z)) + 8.0f*x_3, 2.0f*y*(t0 - 1.0f) + (8.0f*x_2*y + 2.0f*y_3), t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -101,20 +101,20 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float dz_2 = dz*dz;
     float t0 = y_2 + z_2;
     float t1 = t0 - 1.0f;
-    float t2 = t0 + x_2 + z;
+    float t2 = t0 + (x_2 + z);
     float t3 = 4.0f*x_2;
     float t4 = 2.0f*dy*y;
     float t5 = 2.0f*dz*z + t4;
     float t6 = dx*x;
     float t7 = 8.0f*t6;
-    float t8 = dz + t5 + 2.0f*t6;
+    float t8 = 2.0f*t6 + (dz + t5);
     float t9 = dy_2 + dz_2;
     float t10 = dx_2 + t9;
     float t11 = 4.0f*dx_2;
     float c0 = t1*y_2 + t2*t3;
-    float c1 = t1*t4 + t2*t7 + t3*t8 + t5*y_2;
-    float c2 = dy_2*t1 + t10*t3 + t11*t2 + t4*t5 + t7*t8 + t9*y_2;
-    float c3 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
+    float c1 = (t1*t4 + t5*y_2) + (t2*t7 + t3*t8);
+    float c2 = (t11*t2 + (t4*t5 + t9*y_2)) + (t7*t8 + (dy_2*t1 + t10*t3));
+    float c3 = t11*t8 + (t10*t7 + (dy_2*t5 + t4*t9));
     float c4 = dy_2*t9 + t10*t11;
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};

@@ -54,7 +54,7 @@ double S(double3 p) {
     double y_2 = y*y;
     double z_2 = z*z;
     double t0 = y_2 + z_2;
-    return 4.0*x_2*(t0 + x_2 + z) + y_2*(t0 - 1.0);
+    return 4.0*x_2*(t0 + (x_2 + z)) + y_2*(t0 - 1.0);
 }
 
 // grad at the point p
@@ -69,7 +69,7 @@ double3 grad(double3 p) {
     double z_2 = z*z;
     double t0 = y_2 + z_2;
     double t1 = 2.0*z;
-    return (double3)(8.0*x*(t0 + x_2 + z) + 8.0*x_3, 8.0*x_2*y + 2.0*y*(t0 - 1.0) + 2.0*y_3, t1*y_2 + 4.0*x_2*(t1 + 1.0));
+    return (double3)(8.0*x*(t0 + (x_2 + z)) + 8.0*x_3, 2.0*y*(t0 - 1.0) + (8.0*x_2*y + 2.0*y_3), t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -102,20 +102,20 @@ Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     double dz_2 = dz*dz;
     double t0 = y_2 + z_2;
     double t1 = t0 - 1.0;
-    double t2 = t0 + x_2 + z;
+    double t2 = t0 + (x_2 + z);
     double t3 = 4.0*x_2;
     double t4 = 2.0*dy*y;
     double t5 = 2.0*dz*z + t4;
     double t6 = dx*x;
     double t7 = 8.0*t6;
-    double t8 = dz + t5 + 2.0*t6;
+    double t8 = 2.0*t6 + (dz + t5);
     double t9 = dy_2 + dz_2;
     double t10 = dx_2 + t9;
     double t11 = 4.0*dx_2;
     double c0 = t1*y_2 + t2*t3;
-    double c1 = t1*t4 + t2*t7 + t3*t8 + t5*y_2;
-    double c2 = dy_2*t1 + t10*t3 + t11*t2 + t4*t5 + t7*t8 + t9*y_2;
-    double c3 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
+    double c1 = (t1*t4 + t5*y_2) + (t2*t7 + t3*t8);
+    double c2 = (t11*t2 + (t4*t5 + t9*y_2)) + (t7*t8 + (dy_2*t1 + t10*t3));
+    double c3 = t11*t8 + (t10*t7 + (dy_2*t5 + t4*t9));
     double c4 = dy_2*t9 + t10*t11;
     double size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};

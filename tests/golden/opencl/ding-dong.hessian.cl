@@ -51,7 +51,7 @@ float S(float3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return x_2 + y_2 - z_2*(1.0f - z);
+    return -z_2*(1.0f - z) + (x_2 + y_2);
 }
 
 // grad at the point p
@@ -94,9 +94,9 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float dz_3 = dz*dz_2;
     float t0 = 1.0f - z;
     float t1 = 2.0f*z;
-    float c0 = -t0*z_2 + x_2 + y_2;
-    float c1 = 2.0f*dx*x + 2.0f*dy*y - dz*t0*t1 + dz*z_2;
-    float c2 = dx_2 + dy_2 - dz_2*t0 + dz_2*t1;
+    float c0 = -t0*z_2 + (x_2 + y_2);
+    float c1 = -dz*t0*t1 + (dz*z_2 + (2.0f*dx*x + 2.0f*dy*y));
+    float c2 = -dz_2*t0 + (dz_2*t1 + (dx_2 + dy_2));
     float c3 = dz_3;
     float size = hr*(hr*(hr*fabs(c3) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3};

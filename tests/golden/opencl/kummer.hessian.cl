@@ -56,9 +56,9 @@ float S(float3 p) {
     float t1 = t0*y;
     float t2 = z + 1.0f;
     float t3 = t0*x;
-    float t4 = x_2 + y_2 + z_2 - 1.3f;
+    float t4 = (x_2 - 1.3f) + (y_2 + z_2);
     float t4_2 = t4*t4;
-    return t4_2 - 1.7058823529411766f*(t1 + t2)*(-t1 + t2)*(t3 - z + 1.0f)*(-t3 - z + 1.0f);
+    return t4_2 - 1.7058823529411766f*(t1 + t2)*(-t1 + t2)*(t3 + (1.0f - z))*(-t3 + (1.0f - z));
 }
 
 // grad at the point p
@@ -69,22 +69,22 @@ float3 grad(float3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 - 5.2f;
+    float t0 = (4.0f*x_2 - 5.2f) + (4.0f*y_2 + 4.0f*z_2);
     float t1 = 1.4142135623730951f;
     float t2 = t1*x;
-    float t3 = t2 - z + 1.0f;
+    float t3 = t2 + (1.0f - z);
     float t4 = t1*y;
     float t5 = z + 1.0f;
     float t6 = t4 + t5;
     float t7 = -t4 + t5;
     float t8 = 1.7058823529411766f*t6*t7;
     float t9 = t3*t8;
-    float t10 = -t2 - z + 1.0f;
+    float t10 = -t2 + (1.0f - z);
     float t11 = t10*t8;
     float t12 = 1.7058823529411766f*t10*t3;
     float t13 = t12*t6;
     float t14 = t12*t7;
-    return (float3)(t0*x - t1*t11 + t1*t9, t0*y + t1*t13 - t1*t14, t0*z + t11 - t13 - t14 + t9);
+    return (float3)(-t1*t11 + (t0*x + t1*t9), -t1*t14 + (t0*y + t1*t13), (-t13 + t9) + (-t14 + (t0*z + t11)));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -115,18 +115,18 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = x_2 + y_2 + z_2 - 1.3f;
+    float t0 = (x_2 - 1.3f) + (y_2 + z_2);
     float t0_2 = t0*t0;
     float t1 = 1.4142135623730951f;
     float t2 = t1*x;
-    float t3 = -t2 - z + 1.0f;
-    float t4 = t2 - z + 1.0f;
+    float t3 = -t2 + (1.0f - z);
+    float t4 = t2 + (1.0f - z);
     float t5 = t1*y;
-    float t6 = -1.7058823529411766f*t5 - 1.7058823529411766f*z - 1.7058823529411766f;
-    float t7 = -t5 + z + 1.0f;
+    float t6 = -1.7058823529411766f*t5 + (-1.7058823529411766f*z - 1.7058823529411766f);
+    float t7 = -t5 + (z + 1.0f);
     float t8 = t6*t7;
     float t9 = t4*t8;
-    float t10 = 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z;
+    float t10 = 2.0f*dz*z + (2.0f*dx*x + 2.0f*dy*y);
     float t10_2 = t10*t10;
     float t11 = 2.0f*t0;
     float t12 = dx*t1;
@@ -138,15 +138,15 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float t18 = -t14 - t16;
     float t19 = t17*t7 + t18*t6;
     float t20 = t15*t8 + t19*t4;
-    float t21 = dx_2 + dy_2 + dz_2;
+    float t21 = dz_2 + (dx_2 + dy_2);
     float t21_2 = t21*t21;
     float t22 = t17*t18;
     float t23 = t15*t19 + t22*t4;
     float t24 = t15*t22;
     float c0 = t0_2 + t3*t9;
-    float c1 = t10*t11 + t13*t9 + t20*t3;
-    float c2 = t10_2 + t11*t21 + t13*t20 + t23*t3;
-    float c3 = 2.0f*t10*t21 + t13*t23 + t24*t3;
+    float c1 = t20*t3 + (t10*t11 + t13*t9);
+    float c2 = t23*t3 + (t13*t20 + (t10_2 + t11*t21));
+    float c3 = t13*t23 + (2.0f*t10*t21 + t24*t3);
     float c4 = t13*t24 + t21_2;
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};

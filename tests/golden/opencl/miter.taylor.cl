@@ -68,7 +68,7 @@ float3 grad(float3 p) {
     float z_2 = z*z;
     float t0 = y_2 + z_2;
     float t1 = 8.0f*x_2;
-    return (float3)(8.0f*x*(t0 + x_2) + 8.0f*x_3, t1*y - 2.0f*y*(1.0f - t0) + 2.0f*y_3, t1*z + 2.0f*y_2*z);
+    return (float3)(8.0f*x*(t0 + x_2) + 8.0f*x_3, -2.0f*y*(1.0f - t0) + (t1*y + 2.0f*y_3), t1*z + 2.0f*y_2*z);
 }
 
 // dS at march parameter s: Horner on the ray polynomial
@@ -109,9 +109,9 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float t12 = dx_2 + t11;
     float t13 = -t11;
     float c0 = t1*t2 - t3*y_2;
-    float c1 = t1*t8 + t2*t9 - t3*t4 - t6*y_2;
-    float c2 = -dy_2*t3 + t1*t10 + t12*t2 - t13*y_2 - t4*t6 + t8*t9;
-    float c3 = -dy_2*t6 + t10*t9 + t12*t8 - t13*t4;
+    float c1 = (t1*t8 + t2*t9) + (-t3*t4 - t6*y_2);
+    float c2 = (-dy_2*t3 - t4*t6) + ((t1*t10 + t12*t2) + (-t13*y_2 + t8*t9));
+    float c3 = (-dy_2*t6 - t13*t4) + (t10*t9 + t12*t8);
     float c4 = -dy_2*t13 + t10*t12;
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};

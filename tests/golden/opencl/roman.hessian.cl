@@ -52,7 +52,7 @@ float S(float3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return -x*y*z + x_2*y_2 + x_2*z_2 + y_2*z_2;
+    return (x_2*z_2 + y_2*z_2) + (-x*y*z + x_2*y_2);
 }
 
 // grad at the point p
@@ -66,7 +66,7 @@ float3 grad(float3 p) {
     float t0 = 2.0f*x;
     float t1 = 2.0f*y;
     float t2 = 2.0f*z;
-    return (float3)(t0*y_2 + t0*z_2 - y*z, t1*x_2 + t1*z_2 - x*z, t2*x_2 + t2*y_2 - x*y);
+    return (float3)(t0*z_2 + (t0*y_2 - y*z), t1*z_2 + (t1*x_2 - x*z), t2*y_2 + (t2*x_2 - x*y));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -112,11 +112,11 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float t12 = 2.0f*t2;
     float t13 = 2.0f*t4;
     float t14 = 2.0f*t6;
-    float c0 = -t0*z + x_2*y_2 + x_2*z_2 + y_2*z_2;
-    float c1 = -dz*t0 + t1*t2 + t1*t6 + t2*t3 + t3*t4 + t4*t5 + t5*t6 + t9*z;
-    float c2 = dx_2*y_2 + dx_2*z_2 + dy_2*x_2 + dy_2*z_2 + dz*t9 + dz_2*x_2 + dz_2*y_2 - t10*z + t11*t2 + t11*t4 + 4.0f*t7*t8;
-    float c3 = dx_2*t13 + dx_2*t14 + dy_2*t12 + dy_2*t14 - dz*t10 + dz_2*t12 + dz_2*t13;
-    float c4 = dx_2*dy_2 + dx_2*dz_2 + dy_2*dz_2;
+    float c0 = (-t0*z + y_2*z_2) + (x_2*y_2 + x_2*z_2);
+    float c1 = ((-dz*t0 + t1*t2) + (t1*t6 + t2*t3)) + ((t3*t4 + t4*t5) + (t5*t6 + t9*z));
+    float c2 = (dz*t9 + (t11*t2 + t11*t4)) + (((dx_2*y_2 + dx_2*z_2) + (dy_2*x_2 + dy_2*z_2)) + ((dz_2*x_2 + dz_2*y_2) + (-t10*z + 4.0f*t7*t8)));
+    float c3 = (dz_2*t13 + (dx_2*t13 - dz*t10)) + ((dx_2*t14 + dy_2*t12) + (dy_2*t14 + dz_2*t12));
+    float c4 = dy_2*dz_2 + (dx_2*dy_2 + dx_2*dz_2);
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }

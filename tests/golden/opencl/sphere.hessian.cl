@@ -50,7 +50,7 @@ float S(float3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    return x_2 + y_2 + z_2 - 1.0f;
+    return (x_2 - 1.0f) + (y_2 + z_2);
 }
 
 // grad at the point p
@@ -89,9 +89,9 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float c0 = x_2 + y_2 + z_2 - 1.0f;
-    float c1 = 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z;
-    float c2 = dx_2 + dy_2 + dz_2;
+    float c0 = (x_2 - 1.0f) + (y_2 + z_2);
+    float c1 = 2.0f*dz*z + (2.0f*dx*x + 2.0f*dy*y);
+    float c2 = dz_2 + (dx_2 + dy_2);
     float size = hr*(hr*fabs(c2) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2};
 }

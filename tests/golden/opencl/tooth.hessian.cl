@@ -55,7 +55,7 @@ float S(float3 p) {
     float y_4 = y_2*y_2;
     float z_2 = z*z;
     float z_4 = z_2*z_2;
-    return -x_2 + x_4 - y_2 + y_4 - z_2 + z_4;
+    return (-y_2 - z_2) + ((-x_2 + z_4) + (x_4 + y_4));
 }
 
 // grad at the point p
@@ -112,11 +112,11 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float dz_2 = dz*dz;
     float dz_3 = dz*dz_2;
     float dz_4 = dz_2*dz_2;
-    float c0 = -x_2 + x_4 - y_2 + y_4 - z_2 + z_4;
-    float c1 = -2.0f*dx*x + 4.0f*dx*x_3 - 2.0f*dy*y + 4.0f*dy*y_3 - 2.0f*dz*z + 4.0f*dz*z_3;
-    float c2 = 6.0f*dx_2*x_2 - dx_2 + 6.0f*dy_2*y_2 - dy_2 + 6.0f*dz_2*z_2 - dz_2;
-    float c3 = 4.0f*dx_3*x + 4.0f*dy_3*y + 4.0f*dz_3*z;
-    float c4 = dx_4 + dy_4 + dz_4;
+    float c0 = (-y_2 - z_2) + ((-x_2 + z_4) + (x_4 + y_4));
+    float c1 = (4.0f*dx*x_3 + 4.0f*dy*y_3) + (4.0f*dz*z_3 + (-2.0f*dz*z + (-2.0f*dx*x - 2.0f*dy*y)));
+    float c2 = (6.0f*dy_2*y_2 + 6.0f*dz_2*z_2) + ((-dx_2 - dy_2) + (6.0f*dx_2*x_2 - dz_2));
+    float c3 = 4.0f*dz_3*z + (4.0f*dx_3*x + 4.0f*dy_3*y);
+    float c4 = dz_4 + (dx_4 + dy_4);
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }

@@ -52,9 +52,9 @@ float S(float3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = x_2 + y_2 + z_2 + 0.8775f;
+    float t0 = (x_2 + 0.8775f) + (y_2 + z_2);
     float t0_2 = t0*t0;
-    return t0_2 - 4.0f*x_2 - 4.0f*y_2;
+    return t0_2 + (-4.0f*x_2 - 4.0f*y_2);
 }
 
 // grad at the point p
@@ -65,7 +65,7 @@ float3 grad(float3 p) {
     float x_2 = x*x;
     float y_2 = y*y;
     float z_2 = z*z;
-    float t0 = 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 + 3.51f;
+    float t0 = (4.0f*x_2 + 3.51f) + (4.0f*y_2 + 4.0f*z_2);
     return (float3)(t0*x - 8.0f*x, t0*y - 8.0f*y, t0*z);
 }
 
@@ -97,17 +97,17 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float dx_2 = dx*dx;
     float dy_2 = dy*dy;
     float dz_2 = dz*dz;
-    float t0 = x_2 + y_2 + z_2 + 0.8775f;
+    float t0 = (x_2 + 0.8775f) + (y_2 + z_2);
     float t0_2 = t0*t0;
     float t1 = dx*x;
     float t2 = dy*y;
-    float t3 = 2.0f*dz*z + 2.0f*t1 + 2.0f*t2;
+    float t3 = 2.0f*t2 + (2.0f*dz*z + 2.0f*t1);
     float t3_2 = t3*t3;
-    float t4 = dx_2 + dy_2 + dz_2;
+    float t4 = dz_2 + (dx_2 + dy_2);
     float t4_2 = t4*t4;
-    float c0 = t0_2 - 4.0f*x_2 - 4.0f*y_2;
-    float c1 = 2.0f*t0*t3 - 8.0f*t1 - 8.0f*t2;
-    float c2 = -4.0f*dx_2 - 4.0f*dy_2 + 2.0f*t0*t4 + t3_2;
+    float c0 = t0_2 + (-4.0f*x_2 - 4.0f*y_2);
+    float c1 = 2.0f*t0*t3 + (-8.0f*t1 - 8.0f*t2);
+    float c2 = t3_2 + (2.0f*t0*t4 + (-4.0f*dx_2 - 4.0f*dy_2));
     float c3 = 2.0f*t3*t4;
     float c4 = t4_2;
     float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);

@@ -90,8 +90,8 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float dy_2 = dy*dy;
     float t0 = 2.0f*dy*y;
     float c0 = x_2 - y_2*z;
-    float c1 = 2.0f*dx*x - dz*y_2 - t0*z;
-    float c2 = dx_2 - dy_2*z - dz*t0;
+    float c1 = -t0*z + (2.0f*dx*x - dz*y_2);
+    float c2 = -dz*t0 + (dx_2 - dy_2*z);
     float c3 = -dy_2*dz;
     float size = hr*(hr*(hr*fabs(c3) + fabs(c2)) + fabs(c1)) + fabs(c0);
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3};

@@ -66,7 +66,7 @@ fn S(p: vec3<f32>) -> f32 {
     let t4_2: f32 = t4*t4;
     let t5: f32 = y + 0.3f;
     let t5_2: f32 = t5*t5;
-    return -exp(-t0 - 4.0f*t1_2 - 4.0f*y_2) - exp(-t0 - 4.0f*t2_2 - 4.0f*t3_2) - exp(-4.0f*t4_2 - 4.0f*t5_2 - 4.0f*x_2) + 0.6f;
+    return (0.6f - exp(-4.0f*t1_2 + (-t0 - 4.0f*y_2))) + (-exp(-4.0f*t3_2 + (-t0 - 4.0f*t2_2)) - exp(-4.0f*t5_2 + (-4.0f*t4_2 - 4.0f*x_2)));
 }
 
 // grad at the point p
@@ -81,20 +81,20 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let t0_2: f32 = t0*t0;
     let t1: f32 = y + 0.3f;
     let t1_2: f32 = t1*t1;
-    let t2: f32 = exp(-4.0f*t0_2 - 4.0f*t1_2 - 4.0f*x_2);
+    let t2: f32 = exp(-4.0f*t1_2 + (-4.0f*t0_2 - 4.0f*x_2));
     let t3: f32 = 8.0f*x;
     let t4: f32 = 4.0f*z_2;
     let t5: f32 = x - 0.5f;
     let t5_2: f32 = t5*t5;
-    let t6: f32 = exp(-t4 - 4.0f*t5_2 - 4.0f*y_2);
+    let t6: f32 = exp(-4.0f*t5_2 + (-t4 - 4.0f*y_2));
     let t7: f32 = y - 0.4f;
     let t7_2: f32 = t7*t7;
     let t8: f32 = x + 0.4f;
     let t8_2: f32 = t8*t8;
-    let t9: f32 = exp(-t4 - 4.0f*t7_2 - 4.0f*t8_2);
+    let t9: f32 = exp(-4.0f*t8_2 + (-t4 - 4.0f*t7_2));
     let t10: f32 = 8.0f*y;
     let t11: f32 = 8.0f*z;
-    return vec3<f32>(8.0f*t2*x - t6*(4.0f - t3) - t9*(-t3 - 3.2f), -t2*(-t10 - 2.4f) + 8.0f*t6*y - t9*(3.2f - t10), t11*t6 + t11*t9 - t2*(4.0f - t11));
+    return vec3<f32>(8.0f*t2*x + (-t6*(4.0f - t3) - t9*(-t3 - 3.2f)), 8.0f*t6*y + (-t2*(-t10 - 2.4f) - t9*(3.2f - t10)), -t2*(4.0f - t11) + (t11*t6 + t11*t9));
 }
 
 // S, dS, d2S at the point p along the unit direction d
@@ -114,17 +114,17 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let t0: f32 = 4.0f*z_2;
     let t1: f32 = x - 0.5f;
     let t1_2: f32 = t1*t1;
-    let t2: f32 = exp(-t0 - 4.0f*t1_2 - 4.0f*y_2);
+    let t2: f32 = exp(-4.0f*t1_2 + (-t0 - 4.0f*y_2));
     let t3: f32 = z - 0.5f;
     let t3_2: f32 = t3*t3;
     let t4: f32 = y + 0.3f;
     let t4_2: f32 = t4*t4;
-    let t5: f32 = exp(-4.0f*t3_2 - 4.0f*t4_2 - 4.0f*x_2);
+    let t5: f32 = exp(-4.0f*t4_2 + (-4.0f*t3_2 - 4.0f*x_2));
     let t6: f32 = y - 0.4f;
     let t6_2: f32 = t6*t6;
     let t7: f32 = x + 0.4f;
     let t7_2: f32 = t7*t7;
-    let t8: f32 = exp(-t0 - 4.0f*t6_2 - 4.0f*t7_2);
+    let t8: f32 = exp(-4.0f*t7_2 + (-t0 - 4.0f*t6_2));
     let t9: f32 = 8.0f*z;
     let t10: f32 = 4.0f - t9;
     let t10_2: f32 = t10*t10;
@@ -144,8 +144,8 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let t20: f32 = t19*t5;
     let t21: f32 = 2.0f*dx;
     let t22: f32 = 64.0f*t2;
-    let t23: f32 = -8.0f*t2 - 8.0f*t5 - 8.0f*t8;
-    return vec3<f32>(-t2 - t5 - t8 + 0.6f, dx*(-t14 - t16 + 8.0f*t5*x) + dy*(-t18*t8 + 8.0f*t2*y - t20) + dz*(-t11 + t2*t9 + t8*t9), dx_2*(-t13_2*t2 - t15_2*t8 - t23 - 64.0f*t5*x_2) + 2.0f*dy*dz*(-t10*t20 + 8.0f*t18*t8*z - t22*y*z) + dy*t21*(t12*t20 + t14*t17 - t16*t18) + dy_2*(-t18_2*t8 - t19_2*t5 - t22*y_2 - t23) + dz*t21*(t11*t12 + t14*t9 + t16*t9) + dz_2*(-t10_2*t5 - t22*z_2 - t23 - 64.0f*t8*z_2));
+    let t23: f32 = -8.0f*t8 + (-8.0f*t2 - 8.0f*t5);
+    return vec3<f32>((0.6f - t2) + (-t5 - t8), dx*(-t16 + (-t14 + 8.0f*t5*x)) + (dy*(-t20 + (-t18*t8 + 8.0f*t2*y)) + dz*(-t11 + (t2*t9 + t8*t9))), (dy_2*(-t23 + (-t22*y_2 + (-t18_2*t8 - t19_2*t5))) + dz_2*(-t23 + (-t22*z_2 + (-t10_2*t5 - 64.0f*t8*z_2)))) + ((dx_2*(-t23 + (-64.0f*t5*x_2 + (-t13_2*t2 - t15_2*t8))) + 2.0f*dy*dz*(-t22*y*z + (-t10*t20 + 8.0f*t18*t8*z))) + (dy*t21*(-t16*t18 + (t12*t20 + t14*t17)) + dz*t21*(t16*t9 + (t11*t12 + t14*t9)))));
 }
 
 // S, dS at the point p along the unit direction d
@@ -162,21 +162,21 @@ fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     let t0: f32 = 4.0f*z_2;
     let t1: f32 = x - 0.5f;
     let t1_2: f32 = t1*t1;
-    let t2: f32 = exp(-t0 - 4.0f*t1_2 - 4.0f*y_2);
+    let t2: f32 = exp(-4.0f*t1_2 + (-t0 - 4.0f*y_2));
     let t3: f32 = z - 0.5f;
     let t3_2: f32 = t3*t3;
     let t4: f32 = y + 0.3f;
     let t4_2: f32 = t4*t4;
-    let t5: f32 = exp(-4.0f*t3_2 - 4.0f*t4_2 - 4.0f*x_2);
+    let t5: f32 = exp(-4.0f*t4_2 + (-4.0f*t3_2 - 4.0f*x_2));
     let t6: f32 = y - 0.4f;
     let t6_2: f32 = t6*t6;
     let t7: f32 = x + 0.4f;
     let t7_2: f32 = t7*t7;
-    let t8: f32 = exp(-t0 - 4.0f*t6_2 - 4.0f*t7_2);
+    let t8: f32 = exp(-4.0f*t7_2 + (-t0 - 4.0f*t6_2));
     let t9: f32 = 8.0f*z;
     let t10: f32 = 8.0f*x;
     let t11: f32 = 8.0f*y;
-    return vec2<f32>(-t2 - t5 - t8 + 0.6f, dx*(-t2*(4.0f - t10) + 8.0f*t5*x - t8*(-t10 - 3.2f)) + dy*(8.0f*t2*y - t5*(-t11 - 2.4f) - t8*(3.2f - t11)) + dz*(t2*t9 - t5*(4.0f - t9) + t8*t9));
+    return vec2<f32>((0.6f - t2) + (-t5 - t8), dz*(-t5*(4.0f - t9) + (t2*t9 + t8*t9)) + (dx*(8.0f*t5*x + (-t2*(4.0f - t10) - t8*(-t10 - 3.2f))) + dy*(8.0f*t2*y + (-t5*(-t11 - 2.4f) - t8*(3.2f - t11)))));
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval

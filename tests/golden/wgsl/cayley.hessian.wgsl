@@ -60,7 +60,7 @@ fn S(p: vec3<f32>) -> f32 {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    return 16.0f*x*y*z + 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 - 1.0f;
+    return (4.0f*x_2 + 4.0f*y_2) + (4.0f*z_2 + (16.0f*x*y*z - 1.0f));
 }
 
 // grad at the point p
@@ -105,9 +105,9 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let t2: f32 = 16.0f*dy;
     let t3: f32 = dx*t0 + t2*x;
     let t4: f32 = dx*t2;
-    let c0: f32 = t1*z + 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 - 1.0f;
-    let c1: f32 = 8.0f*dx*x + 8.0f*dy*y + dz*t1 + 8.0f*dz*z + t3*z;
-    let c2: f32 = 4.0f*dx_2 + 4.0f*dy_2 + dz*t3 + 4.0f*dz_2 + t4*z;
+    let c0: f32 = (4.0f*y_2 + 4.0f*z_2) + (t1*z + (4.0f*x_2 - 1.0f));
+    let c1: f32 = t3*z + (dz*t1 + (8.0f*dz*z + (8.0f*dx*x + 8.0f*dy*y)));
+    let c2: f32 = (4.0f*dz_2 + t4*z) + (dz*t3 + (4.0f*dx_2 + 4.0f*dy_2));
     let c3: f32 = dz*t4;
     let size: f32 = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);

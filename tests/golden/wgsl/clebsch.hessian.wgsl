@@ -66,7 +66,7 @@ fn S(p: vec3<f32>) -> f32 {
     let t0: f32 = 189.0f*x;
     let t1: f32 = 189.0f*y;
     let t2: f32 = 189.0f*z;
-    return -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f;
+    return (((-9.0f*x_2 - 9.0f*y_2) + (-t0*y_2 - 9.0f*z_2)) + ((-t0*z_2 - t1*x_2) + (-t1*z_2 - t2*x_2))) + (((81.0f*x_3 + (54.0f*x*y*z + 126.0f*y*z)) + (81.0f*y_3 + 81.0f*z_3)) + ((-t2*y_2 + (1.0f - 9.0f*x)) + ((-9.0f*y - 9.0f*z) + (126.0f*x*y + 126.0f*x*z))));
 }
 
 // grad at the point p
@@ -78,10 +78,10 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
     let t0: f32 = 378.0f*x;
-    let t1: f32 = t0*y - 126.0f*z + 189.0f*z_2 + 9.0f;
-    let t2: f32 = t0*z - 126.0f*y + 189.0f*y_2;
-    let t3: f32 = -126.0f*x + 189.0f*x_2 + 378.0f*y*z;
-    return vec3<f32>(-t1 - t2 - 18.0f*x + 243.0f*x_2 + 54.0f*y*z, -t1 - t3 + 54.0f*x*z - 18.0f*y + 243.0f*y_2, -t2 - t3 + 54.0f*x*y - 18.0f*z + 243.0f*z_2 - 9.0f);
+    let t1: f32 = (9.0f - 126.0f*z) + (t0*y + 189.0f*z_2);
+    let t2: f32 = t0*z + (-126.0f*y + 189.0f*y_2);
+    let t3: f32 = 189.0f*x_2 + (-126.0f*x + 378.0f*y*z);
+    return vec3<f32>(-t2 + (-t1 + (243.0f*x_2 + (-18.0f*x + 54.0f*y*z))), -t1 + (-t3 + (243.0f*y_2 + (54.0f*x*z - 18.0f*y))), -t2 + (-t3 + ((-18.0f*z - 9.0f) + (54.0f*x*y + 243.0f*z_2))));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -133,10 +133,10 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let t12: f32 = 189.0f*dy;
     let t13: f32 = 189.0f*dz;
     let t14: f32 = 54.0f*dx*y + 54.0f*t7;
-    let c0: f32 = -t0*y_2 - t0*z_2 - t1*x_2 - t1*z_2 - t2*x_2 - t2*y_2 + 54.0f*x*y*z + 126.0f*x*y + 126.0f*x*z - 9.0f*x - 9.0f*x_2 + 81.0f*x_3 + 126.0f*y*z - 9.0f*y - 9.0f*y_2 + 81.0f*y_3 - 9.0f*z - 9.0f*z_2 + 81.0f*z_3 + 1.0f;
-    let c1: f32 = 243.0f*dx*x_2 + 126.0f*dx*y + 126.0f*dx*z - 9.0f*dx + 126.0f*dy*x + 243.0f*dy*y_2 + 126.0f*dy*z - 9.0f*dy + 54.0f*dz*x*y + 126.0f*dz*x + 126.0f*dz*y + 243.0f*dz*z_2 - 9.0f*dz - t10*x - t11*y_2 - t11*z_2 - t12*x_2 - t12*z_2 - t13*x_2 - t13*y_2 + t14*z - 18.0f*t3 - 18.0f*t4 - t5*t8 - 18.0f*t5 - t6*y - t6*z - t7*t8 - t9*z;
-    let c2: f32 = 54.0f*dx*dy*z + 126.0f*dx*dy + 126.0f*dx*dz - dx*t10 - 378.0f*dx*t7 - dx*t9 - dx_2*t1 - dx_2*t2 + 243.0f*dx_2*x - 9.0f*dx_2 + 126.0f*dy*dz - dy*t10 - dy_2*t0 - dy_2*t2 + 243.0f*dy_2*y - 9.0f*dy_2 + dz*t14 - dz*t6 - dz*t9 - dz_2*t0 - dz_2*t1 + 243.0f*dz_2*z - 9.0f*dz_2;
-    let c3: f32 = 54.0f*dx*dy*dz - dx_2*t12 - dx_2*t13 + 81.0f*dx_3 - dy_2*t11 - dy_2*t13 + 81.0f*dy_3 - dz_2*t11 - dz_2*t12 + 81.0f*dz_3;
+    let c0: f32 = (((-9.0f*x_2 - 9.0f*y_2) + (-t0*y_2 - 9.0f*z_2)) + ((-t0*z_2 - t1*x_2) + (-t1*z_2 - t2*x_2))) + (((81.0f*x_3 + (54.0f*x*y*z + 126.0f*y*z)) + (81.0f*y_3 + 81.0f*z_3)) + ((-t2*y_2 + (1.0f - 9.0f*x)) + ((-9.0f*y - 9.0f*z) + (126.0f*x*y + 126.0f*x*z))));
+    let c1: f32 = ((t14*z + (-t10*x + (54.0f*dz*x*y + 126.0f*dz*y))) + ((-t6*y - t6*z) + (-t9*z + (-18.0f*t3 - 18.0f*t4)))) + ((((243.0f*dx*x_2 - t7*t8) + (243.0f*dy*y_2 + 243.0f*dz*z_2)) + (((-9.0f*dx - 9.0f*dy) + (126.0f*dx*y - 9.0f*dz)) + ((126.0f*dx*z + 126.0f*dy*x) + (126.0f*dy*z + 126.0f*dz*x)))) + (((-t11*y_2 - 18.0f*t5) + (-t11*z_2 - t12*x_2)) + ((-t12*z_2 - t13*x_2) + (-t13*y_2 - t5*t8))));
+    let c2: f32 = ((dz*t14 + (243.0f*dz_2*z + (126.0f*dx*dy + 126.0f*dx*dz))) + ((-dx*t10 + (54.0f*dx*dy*z + 126.0f*dy*dz)) + (-dx*t9 - dy*t10))) + (((-dz*t6 - dz*t9) + ((-9.0f*dx_2 - 9.0f*dy_2) + (-dx_2*t1 - 9.0f*dz_2))) + (((-378.0f*dx*t7 - dz_2*t1) + (243.0f*dx_2*x + 243.0f*dy_2*y)) + ((-dx_2*t2 - dy_2*t0) + (-dy_2*t2 - dz_2*t0))));
+    let c3: f32 = ((81.0f*dx_3 - dz_2*t12) + (-dy_2*t13 - dz_2*t11)) + ((81.0f*dy_3 + 81.0f*dz_3) + ((-dx_2*t13 - dy_2*t11) + (54.0f*dx*dy*dz - dx_2*t12)));
     let size: f32 = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);
 }

@@ -52,7 +52,7 @@ fn cross_cap_S(p: vec3<f32>) -> f32 {
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
     let t0: f32 = y_2 + z_2;
-    return 4.0f*x_2*(t0 + x_2 + z) + y_2*(t0 - 1.0f);
+    return 4.0f*x_2*(t0 + (x_2 + z)) + y_2*(t0 - 1.0f);
 }
 
 // grad at the point p
@@ -67,7 +67,7 @@ fn cross_cap_grad(p: vec3<f32>) -> vec3<f32> {
     let z_2: f32 = z*z;
     let t0: f32 = y_2 + z_2;
     let t1: f32 = 2.0f*z;
-    return vec3<f32>(8.0f*x*(t0 + x_2 + z) + 8.0f*x_3, 8.0f*x_2*y + 2.0f*y*(t0 - 1.0f) + 2.0f*y_3, t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
+    return vec3<f32>(8.0f*x*(t0 + (x_2 + z)) + 8.0f*x_3, 2.0f*y*(t0 - 1.0f) + (8.0f*x_2*y + 2.0f*y_3), t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
 }
 
 // P1 = F''', degree 1 in u = t - sm
@@ -116,20 +116,20 @@ fn cross_cap_ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> cross_cap
     let dz_2: f32 = dz*dz;
     let t0: f32 = y_2 + z_2;
     let t1: f32 = t0 - 1.0f;
-    let t2: f32 = t0 + x_2 + z;
+    let t2: f32 = t0 + (x_2 + z);
     let t3: f32 = 4.0f*x_2;
     let t4: f32 = 2.0f*dy*y;
     let t5: f32 = 2.0f*dz*z + t4;
     let t6: f32 = dx*x;
     let t7: f32 = 8.0f*t6;
-    let t8: f32 = dz + t5 + 2.0f*t6;
+    let t8: f32 = 2.0f*t6 + (dz + t5);
     let t9: f32 = dy_2 + dz_2;
     let t10: f32 = dx_2 + t9;
     let t11: f32 = 4.0f*dx_2;
     let c0: f32 = t1*y_2 + t2*t3;
-    let c1: f32 = t1*t4 + t2*t7 + t3*t8 + t5*y_2;
-    let c2: f32 = dy_2*t1 + t10*t3 + t11*t2 + t4*t5 + t7*t8 + t9*y_2;
-    let c3: f32 = dy_2*t5 + t10*t7 + t11*t8 + t4*t9;
+    let c1: f32 = (t1*t4 + t5*y_2) + (t2*t7 + t3*t8);
+    let c2: f32 = (t11*t2 + (t4*t5 + t9*y_2)) + (t7*t8 + (dy_2*t1 + t10*t3));
+    let c3: f32 = t11*t8 + (t10*t7 + (dy_2*t5 + t4*t9));
     let c4: f32 = dy_2*t9 + t10*t11;
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return cross_cap_Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);

@@ -60,7 +60,7 @@ fn S(p: vec3<f32>) -> f32 {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    return x_2 + y_2 - z_2*(1.0f - z);
+    return -z_2*(1.0f - z) + (x_2 + y_2);
 }
 
 // grad at the point p
@@ -103,9 +103,9 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let dz_3: f32 = dz*dz_2;
     let t0: f32 = 1.0f - z;
     let t1: f32 = 2.0f*z;
-    let c0: f32 = -t0*z_2 + x_2 + y_2;
-    let c1: f32 = 2.0f*dx*x + 2.0f*dy*y - dz*t0*t1 + dz*z_2;
-    let c2: f32 = dx_2 + dy_2 - dz_2*t0 + dz_2*t1;
+    let c0: f32 = -t0*z_2 + (x_2 + y_2);
+    let c1: f32 = -dz*t0*t1 + (dz*z_2 + (2.0f*dx*x + 2.0f*dy*y));
+    let c2: f32 = -dz_2*t0 + (dz_2*t1 + (dx_2 + dy_2));
     let c3: f32 = dz_3;
     let size: f32 = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);

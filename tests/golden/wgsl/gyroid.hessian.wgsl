@@ -55,7 +55,7 @@ fn S(p: vec3<f32>) -> f32 {
     let t0: f32 = 3.0f*x;
     let t1: f32 = 3.0f*y;
     let t2: f32 = 3.0f*z;
-    return cos(t1)*sin(t0) + cos(t2)*sin(t1) + cos(t0)*sin(t2);
+    return (cos(t1)*sin(t0) + cos(t0)*sin(t2)) + cos(t2)*sin(t1);
 }
 
 // grad at the point p
@@ -103,7 +103,7 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let t14: f32 = 9.0f*t4;
     let t15: f32 = 9.0f*t11;
     let t16: f32 = 9.0f*t8;
-    return vec3<f32>(t11 + t4 + t8, dx*(3.0f*t10*t3 - t12*t9) + dy*(-t12*t5 + 3.0f*t3*t7) + dz*(3.0f*t10*t7 - 3.0f*t5*t9), dx_2*(-t14 - t15) - 18.0f*dy*dz*t3*t9 - dy*t10*t13*t5 + dy_2*(-t14 - t16) - dz*t1*t13*t7 + dz_2*(-t15 - t16));
+    return vec3<f32>(t8 + (t11 + t4), dy*(-t12*t5 + 3.0f*t3*t7) + (dx*(3.0f*t10*t3 - t12*t9) + dz*(3.0f*t10*t7 - 3.0f*t5*t9)), (dx_2*(-t14 - t15) + (-18.0f*dy*dz*t3*t9 + (-dy*t10*t13*t5 - dz*t1*t13*t7))) + (dy_2*(-t14 - t16) + dz_2*(-t15 - t16)));
 }
 
 // S, dS at the point p along the unit direction d
@@ -124,7 +124,7 @@ fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     let t7: f32 = sin(t5);
     let t8: f32 = cos(t0);
     let t9: f32 = 3.0f*t1;
-    return vec2<f32>(t1*t3 + t4*t6 + t7*t8, dx*(3.0f*t3*t8 - t7*t9) + dy*(3.0f*t3*t6 - t4*t9) + dz*(-3.0f*t4*t7 + 3.0f*t6*t8));
+    return vec2<f32>(t7*t8 + (t1*t3 + t4*t6), dy*(3.0f*t3*t6 - t4*t9) + (dx*(3.0f*t3*t8 - t7*t9) + dz*(-3.0f*t4*t7 + 3.0f*t6*t8)));
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval

@@ -64,10 +64,10 @@ fn S(p: vec3<f32>) -> f32 {
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
     let z_3: f32 = z*z_2;
-    let t0: f32 = x_2 + 2.25f*y_2 + z_2 - 1.0f;
+    let t0: f32 = (x_2 - 1.0f) + (2.25f*y_2 + z_2);
     let t0_2: f32 = t0*t0;
     let t0_3: f32 = t0*t0_2;
-    return t0_3 - x_2*z_3 - 0.1125f*y_2*z_3;
+    return t0_3 + (-x_2*z_3 - 0.1125f*y_2*z_3);
 }
 
 // grad at the point p
@@ -79,9 +79,9 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
     let z_3: f32 = z*z_2;
-    let t0: f32 = x_2 + 2.25f*y_2 + z_2 - 1.0f;
+    let t0: f32 = (x_2 - 1.0f) + (2.25f*y_2 + z_2);
     let t0_2: f32 = t0*t0;
-    return vec3<f32>(6.0f*t0_2*x - 2.0f*x*z_3, 13.5f*t0_2*y - 0.225f*y*z_3, 6.0f*t0_2*z - 3.0f*x_2*z_2 - 0.3375f*y_2*z_2);
+    return vec3<f32>(6.0f*t0_2*x - 2.0f*x*z_3, 13.5f*t0_2*y - 0.225f*y*z_3, 6.0f*t0_2*z + (-3.0f*x_2*z_2 - 0.3375f*y_2*z_2));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -115,7 +115,7 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let dz_2: f32 = dz*dz;
     let dz_3: f32 = dz*dz_2;
     let t0: f32 = 0.1125f*z_3;
-    let t1: f32 = x_2 + 2.25f*y_2 + z_2 - 1.0f;
+    let t1: f32 = (x_2 - 1.0f) + (2.25f*y_2 + z_2);
     let t1_2: f32 = t1*t1;
     let t1_3: f32 = t1*t1_2;
     let t2: f32 = dx*x;
@@ -125,24 +125,24 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let t6: f32 = dz*z_2;
     let t7: f32 = 3.0f*x_2;
     let t8: f32 = 0.3375f*y_2;
-    let t9: f32 = 2.0f*dz*z + t3 + 4.5f*t4;
+    let t9: f32 = 4.5f*t4 + (2.0f*dz*z + t3);
     let t9_2: f32 = t9*t9;
     let t10: f32 = 6.0f*t2;
     let t11: f32 = 0.675f*t4;
     let t12: f32 = dz_2*z;
-    let t13: f32 = dx_2 + 2.25f*dy_2 + dz_2;
+    let t13: f32 = 2.25f*dy_2 + (dx_2 + dz_2);
     let t13_2: f32 = t13*t13;
     let t13_3: f32 = t13*t13_2;
     let t14: f32 = 2.0f*t1*t13 + t9_2;
     let t15: f32 = 0.1125f*dz_3;
     let t16: f32 = 3.0f*dx_2;
     let t17: f32 = 0.3375f*dy_2;
-    let c0: f32 = -t0*y_2 + t1_3 - x_2*z_3;
-    let c1: f32 = 3.0f*t1_2*t9 - t3*z_3 - t5*z_3 - t6*t7 - t6*t8;
-    let c2: f32 = -dx_2*z_3 - dy_2*t0 + t1*t14 + 2.0f*t1*t9_2 - t10*t6 - t11*t6 - t12*t7 - t12*t8 + t13*t1_2;
-    let c3: f32 = -dz_3*x_2 + 4.0f*t1*t13*t9 - t10*t12 - t11*t12 + t14*t9 - t15*y_2 - t16*t6 - t17*t6;
-    let c4: f32 = -dz_3*t3 - dz_3*t5 + t1*t13_2 - t12*t16 - t12*t17 + t13*t14 + 2.0f*t13*t9_2;
-    let c5: f32 = -dx_2*dz_3 - dy_2*t15 + 3.0f*t13_2*t9;
+    let c0: f32 = t1_3 + (-t0*y_2 - x_2*z_3);
+    let c1: f32 = 3.0f*t1_2*t9 + ((-t3*z_3 - t5*z_3) + (-t6*t7 - t6*t8));
+    let c2: f32 = (t1*t14 + ((-dy_2*t0 - t12*t8) + ((-dx_2*z_3 - t10*t6) + (-t11*t6 - t12*t7)))) + (2.0f*t1*t9_2 + t13*t1_2);
+    let c3: f32 = t14*t9 + ((4.0f*t1*t13*t9 + (-t15*y_2 - t17*t6)) + ((-dz_3*x_2 - t10*t12) + (-t11*t12 - t16*t6)));
+    let c4: f32 = t13*t14 + (2.0f*t13*t9_2 + (t1*t13_2 + ((-dz_3*t3 - dz_3*t5) + (-t12*t16 - t12*t17))));
+    let c5: f32 = 3.0f*t13_2*t9 + (-dx_2*dz_3 - dy_2*t15);
     let c6: f32 = t13_3;
     let size: f32 = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);

@@ -65,9 +65,9 @@ fn S(p: vec3<f32>) -> f32 {
     let t1: f32 = t0*y;
     let t2: f32 = z + 1.0f;
     let t3: f32 = t0*x;
-    let t4: f32 = x_2 + y_2 + z_2 - 1.3f;
+    let t4: f32 = (x_2 - 1.3f) + (y_2 + z_2);
     let t4_2: f32 = t4*t4;
-    return t4_2 - 1.7058823529411766f*(t1 + t2)*(-t1 + t2)*(t3 - z + 1.0f)*(-t3 - z + 1.0f);
+    return t4_2 - 1.7058823529411766f*(t1 + t2)*(-t1 + t2)*(t3 + (1.0f - z))*(-t3 + (1.0f - z));
 }
 
 // grad at the point p
@@ -78,22 +78,22 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    let t0: f32 = 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 - 5.2f;
+    let t0: f32 = (4.0f*x_2 - 5.2f) + (4.0f*y_2 + 4.0f*z_2);
     let t1: f32 = 1.4142135623730951f;
     let t2: f32 = t1*x;
-    let t3: f32 = t2 - z + 1.0f;
+    let t3: f32 = t2 + (1.0f - z);
     let t4: f32 = t1*y;
     let t5: f32 = z + 1.0f;
     let t6: f32 = t4 + t5;
     let t7: f32 = -t4 + t5;
     let t8: f32 = 1.7058823529411766f*t6*t7;
     let t9: f32 = t3*t8;
-    let t10: f32 = -t2 - z + 1.0f;
+    let t10: f32 = -t2 + (1.0f - z);
     let t11: f32 = t10*t8;
     let t12: f32 = 1.7058823529411766f*t10*t3;
     let t13: f32 = t12*t6;
     let t14: f32 = t12*t7;
-    return vec3<f32>(t0*x - t1*t11 + t1*t9, t0*y + t1*t13 - t1*t14, t0*z + t11 - t13 - t14 + t9);
+    return vec3<f32>(-t1*t11 + (t0*x + t1*t9), -t1*t14 + (t0*y + t1*t13), (-t13 + t9) + (-t14 + (t0*z + t11)));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -124,18 +124,18 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let dx_2: f32 = dx*dx;
     let dy_2: f32 = dy*dy;
     let dz_2: f32 = dz*dz;
-    let t0: f32 = x_2 + y_2 + z_2 - 1.3f;
+    let t0: f32 = (x_2 - 1.3f) + (y_2 + z_2);
     let t0_2: f32 = t0*t0;
     let t1: f32 = 1.4142135623730951f;
     let t2: f32 = t1*x;
-    let t3: f32 = -t2 - z + 1.0f;
-    let t4: f32 = t2 - z + 1.0f;
+    let t3: f32 = -t2 + (1.0f - z);
+    let t4: f32 = t2 + (1.0f - z);
     let t5: f32 = t1*y;
-    let t6: f32 = -1.7058823529411766f*t5 - 1.7058823529411766f*z - 1.7058823529411766f;
-    let t7: f32 = -t5 + z + 1.0f;
+    let t6: f32 = -1.7058823529411766f*t5 + (-1.7058823529411766f*z - 1.7058823529411766f);
+    let t7: f32 = -t5 + (z + 1.0f);
     let t8: f32 = t6*t7;
     let t9: f32 = t4*t8;
-    let t10: f32 = 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z;
+    let t10: f32 = 2.0f*dz*z + (2.0f*dx*x + 2.0f*dy*y);
     let t10_2: f32 = t10*t10;
     let t11: f32 = 2.0f*t0;
     let t12: f32 = dx*t1;
@@ -147,15 +147,15 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let t18: f32 = -t14 - t16;
     let t19: f32 = t17*t7 + t18*t6;
     let t20: f32 = t15*t8 + t19*t4;
-    let t21: f32 = dx_2 + dy_2 + dz_2;
+    let t21: f32 = dz_2 + (dx_2 + dy_2);
     let t21_2: f32 = t21*t21;
     let t22: f32 = t17*t18;
     let t23: f32 = t15*t19 + t22*t4;
     let t24: f32 = t15*t22;
     let c0: f32 = t0_2 + t3*t9;
-    let c1: f32 = t10*t11 + t13*t9 + t20*t3;
-    let c2: f32 = t10_2 + t11*t21 + t13*t20 + t23*t3;
-    let c3: f32 = 2.0f*t10*t21 + t13*t23 + t24*t3;
+    let c1: f32 = t20*t3 + (t10*t11 + t13*t9);
+    let c2: f32 = t23*t3 + (t13*t20 + (t10_2 + t11*t21));
+    let c3: f32 = t13*t23 + (2.0f*t10*t21 + t24*t3);
     let c4: f32 = t13*t24 + t21_2;
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);

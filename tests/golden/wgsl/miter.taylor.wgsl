@@ -77,7 +77,7 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let z_2: f32 = z*z;
     let t0: f32 = y_2 + z_2;
     let t1: f32 = 8.0f*x_2;
-    return vec3<f32>(8.0f*x*(t0 + x_2) + 8.0f*x_3, t1*y - 2.0f*y*(1.0f - t0) + 2.0f*y_3, t1*z + 2.0f*y_2*z);
+    return vec3<f32>(8.0f*x*(t0 + x_2) + 8.0f*x_3, -2.0f*y*(1.0f - t0) + (t1*y + 2.0f*y_3), t1*z + 2.0f*y_2*z);
 }
 
 // dS at march parameter s: Horner on the ray polynomial
@@ -118,9 +118,9 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let t12: f32 = dx_2 + t11;
     let t13: f32 = -t11;
     let c0: f32 = t1*t2 - t3*y_2;
-    let c1: f32 = t1*t8 + t2*t9 - t3*t4 - t6*y_2;
-    let c2: f32 = -dy_2*t3 + t1*t10 + t12*t2 - t13*y_2 - t4*t6 + t8*t9;
-    let c3: f32 = -dy_2*t6 + t10*t9 + t12*t8 - t13*t4;
+    let c1: f32 = (t1*t8 + t2*t9) + (-t3*t4 - t6*y_2);
+    let c2: f32 = (-dy_2*t3 - t4*t6) + ((t1*t10 + t12*t2) + (-t13*y_2 + t8*t9));
+    let c3: f32 = (-dy_2*t6 - t13*t4) + (t10*t9 + t12*t8);
     let c4: f32 = -dy_2*t13 + t10*t12;
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);

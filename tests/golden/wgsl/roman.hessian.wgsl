@@ -61,7 +61,7 @@ fn S(p: vec3<f32>) -> f32 {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    return -x*y*z + x_2*y_2 + x_2*z_2 + y_2*z_2;
+    return (x_2*z_2 + y_2*z_2) + (-x*y*z + x_2*y_2);
 }
 
 // grad at the point p
@@ -75,7 +75,7 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let t0: f32 = 2.0f*x;
     let t1: f32 = 2.0f*y;
     let t2: f32 = 2.0f*z;
-    return vec3<f32>(t0*y_2 + t0*z_2 - y*z, t1*x_2 + t1*z_2 - x*z, t2*x_2 + t2*y_2 - x*y);
+    return vec3<f32>(t0*z_2 + (t0*y_2 - y*z), t1*z_2 + (t1*x_2 - x*z), t2*y_2 + (t2*x_2 - x*y));
 }
 
 // dS, d2S at march parameter s: Horner on the ray polynomial
@@ -121,11 +121,11 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let t12: f32 = 2.0f*t2;
     let t13: f32 = 2.0f*t4;
     let t14: f32 = 2.0f*t6;
-    let c0: f32 = -t0*z + x_2*y_2 + x_2*z_2 + y_2*z_2;
-    let c1: f32 = -dz*t0 + t1*t2 + t1*t6 + t2*t3 + t3*t4 + t4*t5 + t5*t6 + t9*z;
-    let c2: f32 = dx_2*y_2 + dx_2*z_2 + dy_2*x_2 + dy_2*z_2 + dz*t9 + dz_2*x_2 + dz_2*y_2 - t10*z + t11*t2 + t11*t4 + 4.0f*t7*t8;
-    let c3: f32 = dx_2*t13 + dx_2*t14 + dy_2*t12 + dy_2*t14 - dz*t10 + dz_2*t12 + dz_2*t13;
-    let c4: f32 = dx_2*dy_2 + dx_2*dz_2 + dy_2*dz_2;
+    let c0: f32 = (-t0*z + y_2*z_2) + (x_2*y_2 + x_2*z_2);
+    let c1: f32 = ((-dz*t0 + t1*t2) + (t1*t6 + t2*t3)) + ((t3*t4 + t4*t5) + (t5*t6 + t9*z));
+    let c2: f32 = (dz*t9 + (t11*t2 + t11*t4)) + (((dx_2*y_2 + dx_2*z_2) + (dy_2*x_2 + dy_2*z_2)) + ((dz_2*x_2 + dz_2*y_2) + (-t10*z + 4.0f*t7*t8)));
+    let c3: f32 = (dz_2*t13 + (dx_2*t13 - dz*t10)) + ((dx_2*t14 + dy_2*t12) + (dy_2*t14 + dz_2*t12));
+    let c4: f32 = dy_2*dz_2 + (dx_2*dy_2 + dx_2*dz_2);
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }

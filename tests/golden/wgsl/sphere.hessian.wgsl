@@ -59,7 +59,7 @@ fn S(p: vec3<f32>) -> f32 {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    return x_2 + y_2 + z_2 - 1.0f;
+    return (x_2 - 1.0f) + (y_2 + z_2);
 }
 
 // grad at the point p
@@ -98,9 +98,9 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let dx_2: f32 = dx*dx;
     let dy_2: f32 = dy*dy;
     let dz_2: f32 = dz*dz;
-    let c0: f32 = x_2 + y_2 + z_2 - 1.0f;
-    let c1: f32 = 2.0f*dx*x + 2.0f*dy*y + 2.0f*dz*z;
-    let c2: f32 = dx_2 + dy_2 + dz_2;
+    let c0: f32 = (x_2 - 1.0f) + (y_2 + z_2);
+    let c1: f32 = 2.0f*dz*z + (2.0f*dx*x + 2.0f*dy*y);
+    let c2: f32 = dz_2 + (dx_2 + dy_2);
     let size: f32 = hr*(hr*abs(c2) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2);
 }

@@ -61,7 +61,7 @@ fn S(p: vec3<f32>) -> f32 {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    return -x*y*z + x_2*y_2 - x_2*z_2 + y_2*z_2;
+    return (-x_2*z_2 + y_2*z_2) + (-x*y*z + x_2*y_2);
 }
 
 // grad at the point p
@@ -73,7 +73,7 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
     let t0: f32 = 2.0f*y;
-    return vec3<f32>(2.0f*x*y_2 - 2.0f*x*z_2 - y*z, t0*x_2 + t0*z_2 - x*z, -x*y - 2.0f*x_2*z + 2.0f*y_2*z);
+    return vec3<f32>(2.0f*x*y_2 + (-2.0f*x*z_2 - y*z), t0*z_2 + (t0*x_2 - x*z), 2.0f*y_2*z + (-x*y - 2.0f*x_2*z));
 }
 
 // dS at march parameter s: Horner on the ray polynomial
@@ -113,11 +113,11 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let t11: f32 = 4.0f*t6;
     let t12: f32 = 2.0f*t1;
     let t13: f32 = 2.0f*dx_2;
-    let c0: f32 = -t0*z + x_2*y_2 - x_2*z_2 + y_2*z_2;
-    let c1: f32 = -dz*t0 + t1*t2 - t1*t3 + t2*t6 + t3*t5 + t4*t5 - t4*t6 + t9*z;
-    let c2: f32 = dx_2*y_2 - dx_2*z_2 + dy_2*x_2 + dy_2*z_2 + dz*t9 - dz_2*x_2 + dz_2*y_2 - t1*t11 - t10*z + t11*t5 + 4.0f*t7*t8;
-    let c3: f32 = dy_2*t12 + 2.0f*dy_2*t6 - dz*t10 - dz_2*t12 + 2.0f*dz_2*t5 + t13*t5 - t13*t6;
-    let c4: f32 = dx_2*dy_2 - dx_2*dz_2 + dy_2*dz_2;
+    let c0: f32 = (-t0*z - x_2*z_2) + (x_2*y_2 + y_2*z_2);
+    let c1: f32 = ((-dz*t0 + t1*t2) + (t2*t6 + t3*t5)) + ((-t1*t3 + t4*t5) + (-t4*t6 + t9*z));
+    let c2: f32 = (dz*t9 + (-t1*t11 + t11*t5)) + (((dx_2*y_2 + dy_2*x_2) + (dy_2*z_2 + dz_2*y_2)) + ((-dx_2*z_2 - dz_2*x_2) + (-t10*z + 4.0f*t7*t8)));
+    let c3: f32 = (-t13*t6 + (2.0f*dy_2*t6 - dz*t10)) + ((dy_2*t12 + 2.0f*dz_2*t5) + (-dz_2*t12 + t13*t5));
+    let c4: f32 = -dx_2*dz_2 + (dx_2*dy_2 + dy_2*dz_2);
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }

@@ -64,7 +64,7 @@ fn S(p: vec3<f32>) -> f32 {
     let y_4: f32 = y_2*y_2;
     let z_2: f32 = z*z;
     let z_4: f32 = z_2*z_2;
-    return -x_2 + x_4 - y_2 + y_4 - z_2 + z_4;
+    return (-y_2 - z_2) + ((-x_2 + z_4) + (x_4 + y_4));
 }
 
 // grad at the point p
@@ -121,11 +121,11 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let dz_2: f32 = dz*dz;
     let dz_3: f32 = dz*dz_2;
     let dz_4: f32 = dz_2*dz_2;
-    let c0: f32 = -x_2 + x_4 - y_2 + y_4 - z_2 + z_4;
-    let c1: f32 = -2.0f*dx*x + 4.0f*dx*x_3 - 2.0f*dy*y + 4.0f*dy*y_3 - 2.0f*dz*z + 4.0f*dz*z_3;
-    let c2: f32 = 6.0f*dx_2*x_2 - dx_2 + 6.0f*dy_2*y_2 - dy_2 + 6.0f*dz_2*z_2 - dz_2;
-    let c3: f32 = 4.0f*dx_3*x + 4.0f*dy_3*y + 4.0f*dz_3*z;
-    let c4: f32 = dx_4 + dy_4 + dz_4;
+    let c0: f32 = (-y_2 - z_2) + ((-x_2 + z_4) + (x_4 + y_4));
+    let c1: f32 = (4.0f*dx*x_3 + 4.0f*dy*y_3) + (4.0f*dz*z_3 + (-2.0f*dz*z + (-2.0f*dx*x - 2.0f*dy*y)));
+    let c2: f32 = (6.0f*dy_2*y_2 + 6.0f*dz_2*z_2) + ((-dx_2 - dy_2) + (6.0f*dx_2*x_2 - dz_2));
+    let c3: f32 = 4.0f*dz_3*z + (4.0f*dx_3*x + 4.0f*dy_3*y);
+    let c4: f32 = dz_4 + (dx_4 + dy_4);
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }

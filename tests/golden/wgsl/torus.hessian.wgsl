@@ -61,9 +61,9 @@ fn S(p: vec3<f32>) -> f32 {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    let t0: f32 = x_2 + y_2 + z_2 + 0.8775f;
+    let t0: f32 = (x_2 + 0.8775f) + (y_2 + z_2);
     let t0_2: f32 = t0*t0;
-    return t0_2 - 4.0f*x_2 - 4.0f*y_2;
+    return t0_2 + (-4.0f*x_2 - 4.0f*y_2);
 }
 
 // grad at the point p
@@ -74,7 +74,7 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     let x_2: f32 = x*x;
     let y_2: f32 = y*y;
     let z_2: f32 = z*z;
-    let t0: f32 = 4.0f*x_2 + 4.0f*y_2 + 4.0f*z_2 + 3.51f;
+    let t0: f32 = (4.0f*x_2 + 3.51f) + (4.0f*y_2 + 4.0f*z_2);
     return vec3<f32>(t0*x - 8.0f*x, t0*y - 8.0f*y, t0*z);
 }
 
@@ -106,17 +106,17 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let dx_2: f32 = dx*dx;
     let dy_2: f32 = dy*dy;
     let dz_2: f32 = dz*dz;
-    let t0: f32 = x_2 + y_2 + z_2 + 0.8775f;
+    let t0: f32 = (x_2 + 0.8775f) + (y_2 + z_2);
     let t0_2: f32 = t0*t0;
     let t1: f32 = dx*x;
     let t2: f32 = dy*y;
-    let t3: f32 = 2.0f*dz*z + 2.0f*t1 + 2.0f*t2;
+    let t3: f32 = 2.0f*t2 + (2.0f*dz*z + 2.0f*t1);
     let t3_2: f32 = t3*t3;
-    let t4: f32 = dx_2 + dy_2 + dz_2;
+    let t4: f32 = dz_2 + (dx_2 + dy_2);
     let t4_2: f32 = t4*t4;
-    let c0: f32 = t0_2 - 4.0f*x_2 - 4.0f*y_2;
-    let c1: f32 = 2.0f*t0*t3 - 8.0f*t1 - 8.0f*t2;
-    let c2: f32 = -4.0f*dx_2 - 4.0f*dy_2 + 2.0f*t0*t4 + t3_2;
+    let c0: f32 = t0_2 + (-4.0f*x_2 - 4.0f*y_2);
+    let c1: f32 = 2.0f*t0*t3 + (-8.0f*t1 - 8.0f*t2);
+    let c2: f32 = t3_2 + (2.0f*t0*t4 + (-4.0f*dx_2 - 4.0f*dy_2));
     let c3: f32 = 2.0f*t3*t4;
     let c4: f32 = t4_2;
     let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);

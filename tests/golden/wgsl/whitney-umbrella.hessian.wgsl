@@ -99,8 +99,8 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let dy_2: f32 = dy*dy;
     let t0: f32 = 2.0f*dy*y;
     let c0: f32 = x_2 - y_2*z;
-    let c1: f32 = 2.0f*dx*x - dz*y_2 - t0*z;
-    let c2: f32 = dx_2 - dy_2*z - dz*t0;
+    let c1: f32 = -t0*z + (2.0f*dx*x - dz*y_2);
+    let c2: f32 = -dz*t0 + (dx_2 - dy_2*z);
     let c3: f32 = -dy_2*dz;
     let size: f32 = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);
