@@ -64,4 +64,26 @@ def test_min_and_max_print_as_balanced_trees(target):
     five = printer.doprint(sympy.Max(a, b, c, d, e))
     assert five == f"{name}({name}({name}(a, b), c), {name}(d, e))"
     text = emit(load_surface("cross-cap"), target, "taylor", METHODS["taylor"].defaults)
-    assert f"{name}({name}(f0.x, f1.x), {name}(q, r))" in text
+    low = printer.known_functions["Min"]
+    sign = printer.known_functions["sign"]
+    assert f"{low}({low}(f1.x*{sign}(f0.x), q*{sign}(f0.x)), r*{sign}(f0.x))" in text
+
+
+def test_interval_test_is_zero_in_min_max():
+    """The root tests' one-bound form, min(sign(F0) v) <= 0, is the paper's
+    0 in [min, max] of F0 and the v, on random values with zeros, ties and signs mixed."""
+    import numpy as np
+    import sympy
+
+    from implc.methods import interval_test
+    from implc.numeric import evaluate
+
+    rng = np.random.default_rng(3)
+    values = rng.choice([-2.0, -1e-30, 0.0, 1e-30, 0.5, 3.0], size=(4, 20000))
+    symbols = sympy.symbols("a b c d", real=True)
+    test = interval_test(*symbols)
+    assert isinstance(test, sympy.LessThan) and test.rhs == 0
+    got = evaluate(test.lhs, dict(zip(symbols, values, strict=True))) <= 0
+    want = (values.min(axis=0) <= 0) & (values.max(axis=0) >= 0)
+    assert got.shape == want.shape and (got == want).all()
+    assert want.any() and not want.all()

@@ -150,8 +150,8 @@ def test_printer_types_literals_and_refuses_what_wgsl_cannot_say():
 def test_validator_points_into_the_users_file(monkeypatch):
     text = _emit("cross-cap", "taylor", "paper", "program")
     lines = text.splitlines()
-    line = next(i for i, t in enumerate(lines, 1) if "min(min(f0.x, f1.x)" in t)
-    broken = text.replace("min(min(f0.x, f1.x)", "min(min(f0.w, f1.x)")
+    line = next(i for i, t in enumerate(lines, 1) if "q*sign(f0.x)" in t)
+    broken = text.replace("q*sign(f0.x)", "q*sign(f0.w)")
     verdict = validate(broken, "mine/cc.wgsl")
     assert not verdict.ok
     assert f"mine/cc.wgsl:{line}:" in verdict.messages, verdict.messages

@@ -137,7 +137,7 @@ float cross_cap_step_size(cross_cap_Ray ray, float s, vec3 f0) {
 bool cross_cap_root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h;
     float r = f1.x - 0.5*f1.y*h;
-    return max(max(f0.x, f1.x), max(q, r)) >= 0.0 && min(min(f0.x, f1.x), min(q, r)) <= 0.0;
+    return min(min(f1.x*sign(f0.x), q*sign(f0.x)), r*sign(f0.x)) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket

@@ -144,7 +144,7 @@ float step_size(Ray ray, float s, vec3 f0) {
 bool root_in(vec3 f0, vec3 f1, float h) {
     float q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     float r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
-    return max(max(f0.x, f1.x), max(q, r)) >= 0.0 && min(min(f0.x, f1.x), min(q, r)) <= 0.0;
+    return min(min(f1.x*sign(f0.x), q*sign(f0.x)), r*sign(f0.x)) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket

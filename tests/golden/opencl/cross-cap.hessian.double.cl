@@ -145,7 +145,7 @@ double step_size(Ray ray, double s, double3 f0) {
 bool root_in(double3 f0, double3 f1, double h) {
     double q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
     double r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
-    return fmax(fmax(f0.x, f1.x), fmax(q, r)) >= 0.0 && fmin(fmin(f0.x, f1.x), fmin(q, r)) <= 0.0;
+    return fmin(fmin(f1.x*sign(f0.x), q*sign(f0.x)), r*sign(f0.x)) <= 0.0;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket

@@ -145,7 +145,7 @@ float cross_cap_step_size(cross_cap_Ray ray, float s, float3 f0) {
 bool cross_cap_root_in(float3 f0, float3 f1, float h) {
     float q = f0.x + 0.5f*f0.y*h + 0.5f*f0.z*h*h;
     float r = 0.5f*f0.z*h*h + f1.x - 0.5f*f1.y*h;
-    return fmax(fmax(f0.x, f1.x), fmax(q, r)) >= 0.0f && fmin(fmin(f0.x, f1.x), fmin(q, r)) <= 0.0f;
+    return fmin(fmin(f1.x*sign(f0.x), q*sign(f0.x)), r*sign(f0.x)) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket

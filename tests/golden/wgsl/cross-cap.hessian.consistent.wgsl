@@ -153,7 +153,7 @@ fn step_size(ray: Ray, s: f32, f0: vec3<f32>) -> f32 {
 fn root_in(f0: vec3<f32>, f1: vec3<f32>, h: f32) -> bool {
     let q: f32 = f0.x + 0.5f*f0.y*h + 0.125f*f0.z*h*h;
     let r: f32 = f1.x - 0.5f*f1.y*h + 0.125f*f1.z*h*h;
-    return max(max(f0.x, f1.x), max(q, r)) >= 0.0f && min(min(f0.x, f1.x), min(q, r)) <= 0.0f;
+    return min(min(f1.x*sign(f0.x), q*sign(f0.x)), r*sign(f0.x)) <= 0.0f;
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
