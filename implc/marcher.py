@@ -69,6 +69,7 @@ QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
 # faster there (a march step decides a sign near the surface far more often than the
 # solver, whose evaluations are mostly far from it) and as accurate.
 RAY_DERIVATIVES = ("dS", "d2S")
+_MARCH_POINT = "(ray.o + s0*ray.d) + h*ray.d"  # values_at's point: s = s0 + h
 _DERIVATIVE_ORDER = {"S": 0, "dS": 1, "d2S": 2}
 _LETTER = {"S": "S", "dS": "D", "d2S": "H", "lap": "L"}
 _RETURN_TYPE = {1: "real", 2: "vec2", 3: "vec3"}
@@ -286,20 +287,21 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
         functions += [_horner_function(q, n, printer) for kind, q in wanted if kind == "ray"]
     by_name = {f.name: f for f in functions}
 
-    def call(kind: str, quantities: tuple[str, ...], arg: sympy.Expr) -> str:
+    def call(kind: str, quantities: tuple[str, ...], arg: sympy.Expr,
+             point: str | None = None) -> str:
         at = f"({show(arg)})" if arg.is_Add else show(arg)
         if kind == "ray":
             return f"{prefix}{_ray_name(quantities)}(ray, {show(arg)})"
         fn = by_name[function_name(quantities)]
-        args = [f"ray.o + {at}*ray.d", "ray.d"][: len(fn.params) - len(carried)]
+        args = [point or f"ray.o + {at}*ray.d", "ray.d"][: len(fn.params) - len(carried)]
         args += _from_ray(carried)
         return f"{prefix}{fn.name}({', '.join(args)})"
 
     def calls(quantities: tuple[str, ...], arg: sympy.Expr, stem: str, lets: list,
-              replace: dict) -> None:
+              replace: dict, point: str | None = None) -> None:
         for kind, qs in _split(quantities, form):
             name = f"{stem}{len(lets)}"
-            lets.append((_RETURN_TYPE[len(qs)], name, call(kind, qs, arg)))
+            lets.append((_RETURN_TYPE[len(qs)], name, call(kind, qs, arg, point)))
             for i, q in enumerate(qs):
                 part = name if len(qs) == 1 else f"{name}.{_COMPONENT[i]}"
                 replace[_apply(q, arg)] = _sym(part)
@@ -307,7 +309,9 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     lets: list = []
     replace: dict = {}
     for arg, group in _sample_groups(method).items():
-        calls(group, arg, "e", lets, replace)
+        # the march point s = s0 + h as (o + s0 d) + h d: o + s0 d is known a step early,
+        # so the point is one operation after h, not two after s (templates/marcher.j2)
+        calls(group, arg, "e", lets, replace, _MARCH_POINT if arg == S else None)
     sample = Code(tuple(lets), tuple(show(e.xreplace(replace)) for e in method.sample))
     lets, replace = [], {}
     calls(REFINE_SET, S, "e", lets, replace)
@@ -442,16 +446,43 @@ def _derivative(n: int, m: int, x: sympy.Expr) -> sympy.Expr:
     return _horner([sympy.ff(k, m) * _sym(f"ray.c{k}") for k in range(m, n + 1)], x)
 
 
+def _estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol
+            ) -> tuple[sympy.Expr, list[tuple[sympy.Symbol, sympy.Expr]]]:
+    """sum_k coefficients[k] x^k by Estrin's scheme, (c0 + c1 x) + x^2 (c2 + c3 x), pairs
+    of pairs by x^4, ...; and the powers x^2, x^4, ... it reads, as lets. Its dependency
+    chain is about 2 log2(n) operations where Horner's is 2n (GPU compilers, llvmpipe
+    among them, keep a*b + c as two operations), and a march step is bound by its chain:
+    with the point trick of the trace loop, 2-6 % a frame (docs/RESULTS.md)."""
+    terms, powers, step = list(coefficients), [], x
+    while len(terms) > 1:
+        terms = [sympy.Add(terms[i], sympy.Mul(terms[i + 1], step, evaluate=False),
+                           evaluate=False) if i + 1 < len(terms) else terms[i]
+                 for i in range(0, len(terms), 2)]
+        if len(terms) > 1:
+            square = _sym(f"{x.name}_{2 ** (len(powers) + 1)}")
+            powers.append((square, sympy.Mul(step, step, evaluate=False)))
+            step = square
+    return (terms[0] if terms else sympy.S.Zero), powers
+
+
 def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
     """F' and/or F'' at march parameter s (measured from the ray record's origin, the
-    expansion point), each a Horner sum in s."""
-    outputs = tuple(printer.doprint(_derivative(n, _DERIVATIVE_ORDER[q], _sym("s")))
-                    for q in quantities)
+    expansion point), each by Estrin's scheme in s."""
+    s = _sym("s")
+    lets: dict[sympy.Symbol, sympy.Expr] = {}
+    outputs = []
+    for q in quantities:
+        m = _DERIVATIVE_ORDER[q]
+        value, powers = _estrin([sympy.ff(k, m) * _sym(f"ray.c{k}") for k in range(m, n + 1)],
+                                s)
+        lets.update(powers)
+        outputs.append(printer.doprint(value))
     what = ", ".join(quantities)
     return ShaderFunction(_ray_name(quantities),
-                          f"{what} at march parameter s: Horner on the ray polynomial",
+                          f"{what} at march parameter s: Estrin's scheme on the ray polynomial",
                           (("Ray", "ray"), ("real", "s")), _RETURN_TYPE[len(outputs)],
-                          (), outputs)
+                          tuple(("real", k.name, printer.doprint(v)) for k, v in lets.items()),
+                          tuple(outputs))
 
 
 # --- the exact method: root isolation on the ray polynomial ------------------------------

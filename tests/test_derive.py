@@ -110,3 +110,21 @@ def test_no_sum_of_three_terms_is_printed_flat(example):
         for expr in (*(v for _, v in program.assignments), *program.outputs):
             flat = [n for n in sympy.preorder_traversal(expr) if n.is_Add and len(n.args) > 2]
             assert not flat, (example, name, flat[:1])
+
+
+@pytest.mark.parametrize("degree", [0, 1, 2, 3, 4, 5, 8, 12])
+def test_estrin_evaluates_the_polynomial(degree):
+    """The marcher's F', F'' by Estrin's scheme (its powers s^2, s^4, ... as lets) are
+    the polynomial: against numpy's Horner on random coefficients."""
+    import sympy
+
+    from implc.marcher import _estrin
+
+    rng = np.random.default_rng(degree)
+    c = rng.normal(size=degree + 1)
+    s = sympy.Symbol("s", real=True)
+    value, powers = _estrin([sympy.Float(v) for v in c], s)
+    x = rng.uniform(-1.5, 1.5, 64)
+    scope = evaluate_program(powers, [value], {s: x})[0]
+    np.testing.assert_allclose(scope, np.polyval(c[::-1], x), rtol=1e-12, atol=1e-12)
+    assert len(powers) == max(0, (degree).bit_length() - 1)

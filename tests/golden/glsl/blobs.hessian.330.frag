@@ -178,9 +178,10 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     return Ray(oc, rd, sm);
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-vec3 values_at(Ray ray, float s) {
-    vec3 e0 = SDH(ray.o + s*ray.d, ray.d);
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+vec3 values_at(Ray ray, float s, float s0, float h) {
+    vec3 e0 = SDH((ray.o + s0*ray.d) + h*ray.d, ray.d);
     return vec3(e0.x, e0.y, e0.z);
 }
 
@@ -242,7 +243,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     float lo = t0 - ray.sm;
     float hi = t1 - ray.sm;
     float s = lo;
-    vec3 f = values_at(ray, lo);
+    vec3 f = values_at(ray, lo, lo, 0.0);
     float s1 = lo;
     vec3 f1 = f;
     bool found = false;
@@ -251,8 +252,9 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), hi);
-        f1 = values_at(ray, s1);
+        float st = step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
             found = true;

@@ -71,9 +71,10 @@ vec3 grad(vec3 p) {
     return vec3(8.0*x*(t0 + (x_2 + z)) + 8.0*x_3, 2.0*y*(t0 - 1.0) + (8.0*x_2*y + 2.0*y_3), t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 float ray_dS(Ray ray, float s) {
-    return ray.c1 + s*(2.0*ray.c2 + s*(3.0*ray.c3 + 4.0*ray.c4*s));
+    float s_2 = s*s;
+    return (3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s);
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
@@ -115,10 +116,11 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-vec3 values_at(Ray ray, float s) {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+vec3 values_at(Ray ray, float s, float s0, float h) {
     float e0 = ray_dS(ray, s);
-    float e1 = S(ray.o + s*ray.d);
+    float e1 = S((ray.o + s0*ray.d) + h*ray.d);
     float e2 = ray_dS(ray, EPS + s);
     return vec3(e1, e0, (-e0 + e2)/EPS);
 }
@@ -182,7 +184,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     float lo = t0 - ray.sm;
     float hi = t1 - ray.sm;
     float s = lo;
-    vec3 f = values_at(ray, lo);
+    vec3 f = values_at(ray, lo, lo, 0.0);
     float s1 = lo;
     vec3 f1 = f;
     bool found = false;
@@ -191,8 +193,9 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), hi);
-        f1 = values_at(ray, s1);
+        float st = step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
             found = true;

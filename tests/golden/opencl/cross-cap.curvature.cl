@@ -80,9 +80,10 @@ float2 SL(float3 p) {
     return (float2)(4.0f*x_2*(t0 + (x_2 + z)) + y_2*(t0 - 1.0f), (64.0f*x_2 + (8.0f*z - 2.0f)) + (22.0f*y_2 + 10.0f*z_2));
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 float ray_dS(Ray ray, float s) {
-    return ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s));
+    float s_2 = s*s;
+    return (3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s);
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
@@ -124,10 +125,11 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-float3 values_at(Ray ray, float s) {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+float3 values_at(Ray ray, float s, float s0, float h) {
     float e0 = ray_dS(ray, s);
-    float2 e1 = SL(ray.o + s*ray.d);
+    float2 e1 = SL((ray.o + s0*ray.d) + h*ray.d);
     return (float3)(e1.x, e0, e1.y);
 }
 
@@ -190,7 +192,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     float lo = t0 - ray.sm;
     float hi = t1 - ray.sm;
     float s = lo;
-    float3 f = values_at(ray, lo);
+    float3 f = values_at(ray, lo, lo, 0.0f);
     float s1 = lo;
     float3 f1 = f;
     bool found = false;
@@ -199,8 +201,9 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), hi);
-        f1 = values_at(ray, s1);
+        float st = step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
             found = true;

@@ -72,14 +72,16 @@ float3 cross_cap_grad(float3 p) {
     return (float3)(8.0f*x*(t0 + (x_2 + z)) + 8.0f*x_3, 2.0f*y*(t0 - 1.0f) + (8.0f*x_2*y + 2.0f*y_3), t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
 }
 
-// dS, d2S at march parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 float2 cross_cap_ray_DH(cross_cap_Ray ray, float s) {
-    return (float2)(ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s)), 2.0f*ray.c2 + s*(6.0f*ray.c3 + 12.0f*ray.c4*s));
+    float s_2 = s*s;
+    return (float2)((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s), 12.0f*ray.c4*s_2 + (2.0f*ray.c2 + 6.0f*ray.c3*s));
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 float cross_cap_ray_dS(cross_cap_Ray ray, float s) {
-    return ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s));
+    float s_2 = s*s;
+    return (3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s);
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
@@ -121,10 +123,11 @@ cross_cap_Ray cross_cap_ray_of(float3 ro, float3 rd, float sm, float hr) {
     return (cross_cap_Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-float3 cross_cap_values_at(cross_cap_Ray ray, float s) {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+float3 cross_cap_values_at(cross_cap_Ray ray, float s, float s0, float h) {
     float2 e0 = cross_cap_ray_DH(ray, s);
-    float e1 = cross_cap_S(ray.o + s*ray.d);
+    float e1 = cross_cap_S((ray.o + s0*ray.d) + h*ray.d);
     return (float3)(e1, e0.x, e0.y);
 }
 
@@ -187,7 +190,7 @@ cross_cap_Hit cross_cap_trace(float3 ro, float3 rd, float t0, float t1) {
     float lo = t0 - ray.sm;
     float hi = t1 - ray.sm;
     float s = lo;
-    float3 f = cross_cap_values_at(ray, lo);
+    float3 f = cross_cap_values_at(ray, lo, lo, 0.0f);
     float s1 = lo;
     float3 f1 = f;
     bool found = false;
@@ -196,8 +199,9 @@ cross_cap_Hit cross_cap_trace(float3 ro, float3 rd, float t0, float t1) {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + cross_cap_step_size(ray, s, f), hi);
-        f1 = cross_cap_values_at(ray, s1);
+        float st = cross_cap_step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = cross_cap_values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (cross_cap_root_in(f, f1, s1 - s)) {
             found = true;

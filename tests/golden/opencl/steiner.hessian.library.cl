@@ -68,14 +68,16 @@ float3 steiner_grad(float3 p) {
     return (float3)(2.0f*x*y_2 + (-2.0f*x*z_2 - y*z), t0*z_2 + (t0*x_2 - x*z), 2.0f*y_2*z + (-x*y - 2.0f*x_2*z));
 }
 
-// dS, d2S at march parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 float2 steiner_ray_DH(steiner_Ray ray, float s) {
-    return (float2)(ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s)), 2.0f*ray.c2 + s*(6.0f*ray.c3 + 12.0f*ray.c4*s));
+    float s_2 = s*s;
+    return (float2)((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s), 12.0f*ray.c4*s_2 + (2.0f*ray.c2 + 6.0f*ray.c3*s));
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 float steiner_ray_dS(steiner_Ray ray, float s) {
-    return ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s));
+    float s_2 = s*s;
+    return (3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s);
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
@@ -119,10 +121,11 @@ steiner_Ray steiner_ray_of(float3 ro, float3 rd, float sm, float hr) {
     return (steiner_Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-float3 steiner_values_at(steiner_Ray ray, float s) {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+float3 steiner_values_at(steiner_Ray ray, float s, float s0, float h) {
     float2 e0 = steiner_ray_DH(ray, s);
-    float e1 = steiner_S(ray.o + s*ray.d);
+    float e1 = steiner_S((ray.o + s0*ray.d) + h*ray.d);
     return (float3)(e1, e0.x, e0.y);
 }
 
@@ -185,7 +188,7 @@ steiner_Hit steiner_trace(float3 ro, float3 rd, float t0, float t1) {
     float lo = t0 - ray.sm;
     float hi = t1 - ray.sm;
     float s = lo;
-    float3 f = steiner_values_at(ray, lo);
+    float3 f = steiner_values_at(ray, lo, lo, 0.0f);
     float s1 = lo;
     float3 f1 = f;
     bool found = false;
@@ -194,8 +197,9 @@ steiner_Hit steiner_trace(float3 ro, float3 rd, float t0, float t1) {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + steiner_step_size(ray, s, f), hi);
-        f1 = steiner_values_at(ray, s1);
+        float st = steiner_step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = steiner_values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (steiner_root_in(f, f1, s1 - s)) {
             found = true;

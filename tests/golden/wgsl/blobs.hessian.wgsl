@@ -188,9 +188,10 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     return Ray(oc, rd, sm);
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-fn values_at(ray: Ray, s: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH(ray.o + s*ray.d, ray.d);
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+fn values_at(ray: Ray, s: f32, s0: f32, h: f32) -> vec3<f32> {
+    let e0: vec3<f32> = SDH((ray.o + s0*ray.d) + h*ray.d, ray.d);
     return vec3<f32>(e0.x, e0.y, e0.z);
 }
 
@@ -252,7 +253,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let lo: f32 = t0 - ray.sm;
     let hi: f32 = t1 - ray.sm;
     var s: f32 = lo;
-    var f: vec3<f32> = values_at(ray, lo);
+    var f: vec3<f32> = values_at(ray, lo, lo, 0.0f);
     var s1: f32 = lo;
     var f1: vec3<f32> = f;
     var found: bool = false;
@@ -261,8 +262,9 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), hi);
-        f1 = values_at(ray, s1);
+        let st: f32 = step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
             found = true;

@@ -72,14 +72,16 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(t0*y + 8.0f*x, t0*x + 8.0f*y, 16.0f*x*y + 8.0f*z);
 }
 
-// dS, d2S at march parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
-    return vec2<f32>(ray.c1 + s*(2.0f*ray.c2 + 3.0f*ray.c3*s), 2.0f*ray.c2 + 6.0f*ray.c3*s);
+    let s_2: f32 = s*s;
+    return vec2<f32>(3.0f*ray.c3*s_2 + (ray.c1 + 2.0f*ray.c2*s), 2.0f*ray.c2 + 6.0f*ray.c3*s);
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 fn ray_dS(ray: Ray, s: f32) -> f32 {
-    return ray.c1 + s*(2.0f*ray.c2 + 3.0f*ray.c3*s);
+    let s_2: f32 = s*s;
+    return 3.0f*ray.c3*s_2 + (ray.c1 + 2.0f*ray.c2*s);
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
@@ -113,10 +115,11 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     return Ray(oc, rd, sm, size, c0, c1, c2, c3);
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-fn values_at(ray: Ray, s: f32) -> vec3<f32> {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+fn values_at(ray: Ray, s: f32, s0: f32, h: f32) -> vec3<f32> {
     let e0: vec2<f32> = ray_DH(ray, s);
-    let e1: f32 = S(ray.o + s*ray.d);
+    let e1: f32 = S((ray.o + s0*ray.d) + h*ray.d);
     return vec3<f32>(e1, e0.x, e0.y);
 }
 
@@ -179,7 +182,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let lo: f32 = t0 - ray.sm;
     let hi: f32 = t1 - ray.sm;
     var s: f32 = lo;
-    var f: vec3<f32> = values_at(ray, lo);
+    var f: vec3<f32> = values_at(ray, lo, lo, 0.0f);
     var s1: f32 = lo;
     var f1: vec3<f32> = f;
     var found: bool = false;
@@ -188,8 +191,9 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), hi);
-        f1 = values_at(ray, s1);
+        let st: f32 = step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
             found = true;

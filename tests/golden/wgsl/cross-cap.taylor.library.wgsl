@@ -70,9 +70,10 @@ fn cross_cap_grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(8.0f*x*(t0 + (x_2 + z)) + 8.0f*x_3, 2.0f*y*(t0 - 1.0f) + (8.0f*x_2*y + 2.0f*y_3), t1*y_2 + 4.0f*x_2*(t1 + 1.0f));
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 fn cross_cap_ray_dS(ray: cross_cap_Ray, s: f32) -> f32 {
-    return ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s));
+    let s_2: f32 = s*s;
+    return (3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s);
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
@@ -114,10 +115,11 @@ fn cross_cap_ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> cross_cap
     return cross_cap_Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-fn cross_cap_values_at(ray: cross_cap_Ray, s: f32) -> vec3<f32> {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+fn cross_cap_values_at(ray: cross_cap_Ray, s: f32, s0: f32, h: f32) -> vec3<f32> {
     let e0: f32 = cross_cap_ray_dS(ray, s);
-    let e1: f32 = cross_cap_S(ray.o + s*ray.d);
+    let e1: f32 = cross_cap_S((ray.o + s0*ray.d) + h*ray.d);
     return vec3<f32>(e1, e0, 0.0f);
 }
 
@@ -180,7 +182,7 @@ fn cross_cap_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> cross_cap_
     let lo: f32 = t0 - ray.sm;
     let hi: f32 = t1 - ray.sm;
     var s: f32 = lo;
-    var f: vec3<f32> = cross_cap_values_at(ray, lo);
+    var f: vec3<f32> = cross_cap_values_at(ray, lo, lo, 0.0f);
     var s1: f32 = lo;
     var f1: vec3<f32> = f;
     var found: bool = false;
@@ -189,8 +191,9 @@ fn cross_cap_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> cross_cap_
         if (s >= hi) {
             break;
         }
-        s1 = min(s + cross_cap_step_size(ray, s, f), hi);
-        f1 = cross_cap_values_at(ray, s1);
+        let st: f32 = cross_cap_step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = cross_cap_values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (cross_cap_root_in(f, f1, s1 - s)) {
             found = true;

@@ -70,14 +70,16 @@ fn miter_grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(8.0f*x*(t0 + x_2) + 8.0f*x_3, -2.0f*y*(1.0f - t0) + (t1*y + 2.0f*y_3), t1*z + 2.0f*y_2*z);
 }
 
-// dS, d2S at march parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 fn miter_ray_DH(ray: miter_Ray, s: f32) -> vec2<f32> {
-    return vec2<f32>(ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s)), 2.0f*ray.c2 + s*(6.0f*ray.c3 + 12.0f*ray.c4*s));
+    let s_2: f32 = s*s;
+    return vec2<f32>((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s), 12.0f*ray.c4*s_2 + (2.0f*ray.c2 + 6.0f*ray.c3*s));
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 fn miter_ray_dS(ray: miter_Ray, s: f32) -> f32 {
-    return ray.c1 + s*(2.0f*ray.c2 + s*(3.0f*ray.c3 + 4.0f*ray.c4*s));
+    let s_2: f32 = s*s;
+    return (3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s);
 }
 
 // The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
@@ -121,10 +123,11 @@ fn miter_ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> miter_Ray {
     return miter_Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-fn miter_values_at(ray: miter_Ray, s: f32) -> vec3<f32> {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+fn miter_values_at(ray: miter_Ray, s: f32, s0: f32, h: f32) -> vec3<f32> {
     let e0: vec2<f32> = miter_ray_DH(ray, s);
-    let e1: f32 = miter_S(ray.o + s*ray.d);
+    let e1: f32 = miter_S((ray.o + s0*ray.d) + h*ray.d);
     return vec3<f32>(e1, e0.x, e0.y);
 }
 
@@ -187,7 +190,7 @@ fn miter_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> miter_Hit {
     let lo: f32 = t0 - ray.sm;
     let hi: f32 = t1 - ray.sm;
     var s: f32 = lo;
-    var f: vec3<f32> = miter_values_at(ray, lo);
+    var f: vec3<f32> = miter_values_at(ray, lo, lo, 0.0f);
     var s1: f32 = lo;
     var f1: vec3<f32> = f;
     var found: bool = false;
@@ -196,8 +199,9 @@ fn miter_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> miter_Hit {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + miter_step_size(ray, s, f), hi);
-        f1 = miter_values_at(ray, s1);
+        let st: f32 = miter_step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = miter_values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (miter_root_in(f, f1, s1 - s)) {
             found = true;

@@ -70,12 +70,12 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(2.0f*x, 2.0f*y, 2.0f*z);
 }
 
-// dS, d2S at march parameter s: Horner on the ray polynomial
+// dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
     return vec2<f32>(ray.c1 + 2.0f*ray.c2*s, 2.0f*ray.c2);
 }
 
-// dS at march parameter s: Horner on the ray polynomial
+// dS at march parameter s: Estrin's scheme on the ray polynomial
 fn ray_dS(ray: Ray, s: f32) -> f32 {
     return ray.c1 + 2.0f*ray.c2*s;
 }
@@ -105,10 +105,11 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     return Ray(oc, rd, sm, size, c0, c1, c2);
 }
 
-// What the method evaluates at a march point s: (F, F', X), X its extra value.
-fn values_at(ray: Ray, s: f32) -> vec3<f32> {
+// What the method evaluates at a march point s: (F, F', X), X its extra value. s is
+// s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
+fn values_at(ray: Ray, s: f32, s0: f32, h: f32) -> vec3<f32> {
     let e0: vec2<f32> = ray_DH(ray, s);
-    let e1: f32 = S(ray.o + s*ray.d);
+    let e1: f32 = S((ray.o + s0*ray.d) + h*ray.d);
     return vec3<f32>(e1, e0.x, e0.y);
 }
 
@@ -171,7 +172,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let lo: f32 = t0 - ray.sm;
     let hi: f32 = t1 - ray.sm;
     var s: f32 = lo;
-    var f: vec3<f32> = values_at(ray, lo);
+    var f: vec3<f32> = values_at(ray, lo, lo, 0.0f);
     var s1: f32 = lo;
     var f1: vec3<f32> = f;
     var found: bool = false;
@@ -180,8 +181,9 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         if (s >= hi) {
             break;
         }
-        s1 = min(s + step_size(ray, s, f), hi);
-        f1 = values_at(ray, s1);
+        let st: f32 = step_size(ray, s, f);
+        s1 = min(s + st, hi);
+        f1 = values_at(ray, s1, s, min(st, hi - s));
         steps += 1;
         if (root_in(f, f1, s1 - s)) {
             found = true;
