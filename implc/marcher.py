@@ -15,7 +15,7 @@ computed; a method never knows which one it gets:
   (F, F', F'') together;
 - `ray-poly` (polynomial S): the coefficients c_k of F(s) = S(o + s d), expanded about
   the middle of the march interval, are computed once per ray in `ray_of` and kept in
-  the ray record; F' and F'' at s are Horner sums over them (`ray_DH(ray, s)`), about n
+  the ray record; F' and F'' at s are Estrin sums over them (`ray_DH(ray, s)`), about n
   multiply-adds each for degree n. F itself (see RAY_DERIVATIVES) and quantities that
   are not ray derivatives (the Laplacian) stay point functions.
 """
@@ -56,7 +56,7 @@ EVAL_CHOICES = ("auto", *FORMS)
 AUTO_MAX_DEGREE = 6
 
 QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
-# What Horner on the ray polynomial gives: F' and F''. F itself, whose sign is the
+# What the ray polynomial gives (by Estrin's scheme): F' and F''. F itself, whose sign is the
 # answer, is Horner's only where that sign is certain: Horner's float32 value of F, from
 # coefficients rounded once per ray, errs by a smooth offset along the whole ray, which
 # near a double line of a self-intersecting surface adds or removes a pair of roots
@@ -199,7 +199,7 @@ def _sample_groups(method: Method) -> dict[sympy.Expr, tuple[str, ...]]:
 
 
 def _split(quantities: tuple[str, ...], form: str) -> list[tuple[str, tuple[str, ...]]]:
-    """A quantity set as (kind, subset) calls: `ray` (Horner: F', F'') or `point` (F and
+    """A quantity set as (kind, subset) calls: `ray` (Estrin: F', F'') or `point` (F and
     the rest; see RAY_DERIVATIVES)."""
     if form == "point":
         return [("point", quantities)]
@@ -284,7 +284,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
         coefficients = coefficient_program(expr)
         n = len(coefficients.outputs) - 1
         ray_fields, ray = _carry(carried, *_ray_setup(coefficients, printer))
-        functions += [_horner_function(q, n, printer) for kind, q in wanted if kind == "ray"]
+        functions += [_estrin_function(q, n, printer) for kind, q in wanted if kind == "ray"]
     by_name = {f.name: f for f in functions}
 
     def call(kind: str, quantities: tuple[str, ...], arg: sympy.Expr,
@@ -452,7 +452,8 @@ def _estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol
     of pairs by x^4, ...; and the powers x^2, x^4, ... it reads, as lets. Its dependency
     chain is about 2 log2(n) operations where Horner's is 2n (GPU compilers, llvmpipe
     among them, keep a*b + c as two operations), and a march step is bound by its chain:
-    with the point trick of the trace loop, 2-6 % a frame (docs/RESULTS.md)."""
+    with the march point of values_at (_MARCH_POINT), 2-6 % a frame (docs/RESULTS.md,
+    section 3)."""
     terms, powers, step = list(coefficients), [], x
     while len(terms) > 1:
         terms = [sympy.Add(terms[i], sympy.Mul(terms[i + 1], step, evaluate=False),
@@ -465,7 +466,7 @@ def _estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol
     return (terms[0] if terms else sympy.S.Zero), powers
 
 
-def _horner_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
+def _estrin_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
     """F' and/or F'' at march parameter s (measured from the ray record's origin, the
     expansion point), each by Estrin's scheme in s."""
     s = _sym("s")

@@ -121,8 +121,8 @@ def interval_test(start: sympy.Expr, *values: sympy.Expr) -> sympy.Basic:
     makes max >= 0 hold already, so only min <= 0 is asked; F0 < 0 the mirror image;
     F0 = 0 both hold, and sign 0 makes every product 0. Multiplying by sign(F0) (+1, -1
     or 0) is exact in floating point, and F0 is known a step early. One reduction, not
-    two: 7 % a frame on llvmpipe, and the root test left the march's dependency chain
-    (docs/RESULTS.md)."""
+    two, on the march's dependency chain: 7-12 % a frame on llvmpipe (docs/RESULTS.md,
+    section 3)."""
     sigma = sympy.sign(start)
     return Min(*(sigma * v for v in values)) <= 0
 

@@ -1,6 +1,6 @@
 """Turn derived expressions into a straight-line `Program` a printer can emit.
 
-Three passes, all deterministic:
+Four passes, all deterministic:
 1. joint CSE of every output of one shader function (sympy `cse`, canonical order,
    temporaries named t0, t1, ... in order of definition);
 2. integer powers to products: x**4 becomes `x_2 = x*x; x_4 = x_2*x_2`, shared across the
@@ -160,9 +160,9 @@ def _sums_by_depth(assignments, outputs, inputs):
     the printers keep the grouping), the two shallowest terms first, as Huffman's code
     merges the two lightest. GPU compilers keep the order a sum is written in (floating
     point addition is not associative), and a march step is bound by its dependency
-    chain: in the Cross-Cap's S, `t0 + (x_2 + z)` instead of `t0 + x_2 + z` made the
-    hessian march as fast as taylor's on llvmpipe (docs/RESULTS.md). Ties keep sympy's
-    canonical order, so the output stays deterministic."""
+    chain (docs/RESULTS.md, section 3): the Cross-Cap's S ends in `t0 + (x_2 + z)`, not
+    `t0 + x_2 + z`. Ties keep sympy's canonical order, so the output stays
+    deterministic."""
     depth: dict[sympy.Basic, int] = dict.fromkeys(inputs, 0)
 
     def visit(node: sympy.Expr) -> tuple[sympy.Expr, int]:
