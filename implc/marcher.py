@@ -51,8 +51,10 @@ FORMS = ("point", "ray-poly")
 EVAL_CHOICES = ("auto", *FORMS)
 # `auto` takes ray-poly for polynomials up to this degree (docs/RESULTS.md, "Evaluation
 # forms"): as accurate as point evaluation at every degree measured (2 to 12), and faster
-# on every bundled polynomial (degree 2 to 6, 2-25 %); above degree 6 the point form was
-# as fast or faster (sums of n-th powers evaluate cheaply at a point by power chains).
+# on every bundled polynomial (degree 2 to 6, 3-26 %); above degree 6 the point form was
+# as fast or faster with Horner's F' (sums of n-th powers evaluate cheaply at a point by
+# power chains). With Estrin's F', ray-poly measured as fast or faster up to degree 12 in
+# one run (RESULTS section 2); not re-decided on that alone.
 AUTO_MAX_DEGREE = 6
 
 QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
