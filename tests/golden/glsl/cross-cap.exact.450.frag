@@ -77,12 +77,14 @@ float P1(Ray ray, float u) {
 
 // P2 = F'', degree 2 in u = t - sm
 float P2(Ray ray, float u) {
-    return 2.0*ray.c2 + u*(6.0*ray.c3 + 12.0*ray.c4*u);
+    float u_2 = u*u;
+    return 12.0*ray.c4*u_2 + (2.0*ray.c2 + 6.0*ray.c3*u);
 }
 
 // P3 = F', degree 3 in u = t - sm
 float P3(Ray ray, float u) {
-    return ray.c1 + u*(2.0*ray.c2 + u*(3.0*ray.c3 + 4.0*ray.c4*u));
+    float u_2 = u*u;
+    return (3.0*ray.c3 + 4.0*ray.c4*u)*u_2 + (ray.c1 + 2.0*ray.c2*u);
 }
 
 // F at u = t - sm: Horner's value where its sign is certain, else S at the point
