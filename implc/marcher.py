@@ -44,7 +44,7 @@ from .methods import (
     Method,
     S,
 )
-from .optimize import Program, optimize
+from .optimize import Program, count_ops, optimize
 from .symbols import DIRECTION, POINT
 
 FORMS = ("point", "ray-poly")
@@ -466,6 +466,14 @@ def _estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol
             powers.append((square, sympy.Mul(step, step, evaluate=False)))
             step = square
     return (terms[0] if terms else sympy.S.Zero), powers
+
+
+def estrin_ops(degree: int) -> tuple[int, int]:
+    """(operations, of which the powers of s) of a degree-`degree` polynomial by Estrin's
+    scheme, the coefficients taken as given (`implc show`)."""
+    value, powers = _estrin([_sym(f"a{k}") for k in range(degree + 1)], _sym("s"))
+    power_ops = sum(count_ops(v) for _, v in powers)
+    return count_ops(value) + power_ops, power_ops
 
 
 def _estrin_derivative(n: int, m: int, x: sympy.Symbol):

@@ -6,7 +6,7 @@ import sympy
 
 from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
-from .marcher import AUTO_MAX_DEGREE, coefficient_program, evaluations
+from .marcher import AUTO_MAX_DEGREE, coefficient_program, estrin_ops, evaluations
 from .methods import Method
 from .surface import Surface
 from .textform import to_text
@@ -60,13 +60,13 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
             "exact (root isolation of the ray polynomial; no marching):",
             f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
             f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
-            f"  derivatives P1..P{degree - 1} of F by Horner (P_k: {'k multiply-adds'}); "
+            f"  derivatives P1..P{degree - 1} of F by Estrin's scheme; "
             "F by Horner where its sign is certain, else S at the point",
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
-    horner = {"dS": 2 * (degree - 1), "d2S": 2 * max(degree - 2, 0)}
-    per_step = ", ".join(f"{q} {horner[q]}" for q in dict.fromkeys(quantities))
+    orders = {"dS": degree - 1, "d2S": max(degree - 2, 0)}
+    per_step = ", ".join(f"{q} {estrin_ops(orders[q])[0]}" for q in dict.fromkeys(quantities))
     point = [" + ".join(qs) for kind, qs in evaluations(method, "ray-poly")
              if kind == "point" and qs not in (("S",), ("grad",))]
     return [
@@ -74,7 +74,8 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
         f"ray-poly form (chosen by --eval auto up to degree {AUTO_MAX_DEGREE}):",
         f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
         f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
-        f"  per evaluation, Horner (multiply-adds counted as 2): "
+        f"  per evaluation, Estrin's scheme (powers of s included, shared between F' and "
+        f"F''): "
         f"{per_step or 'none'}; F and {', '.join(point) or 'nothing else'} at the point",
     ]
 
