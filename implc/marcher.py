@@ -442,10 +442,15 @@ def _horner(coefficients: Sequence[sympy.Expr], x: sympy.Expr) -> sympy.Expr:
     return value
 
 
+def _derivative_coefficients(n: int, m: int) -> list[sympy.Expr]:
+    """The coefficients k!/(k-m)! c_k of F^(m) over the ray record's c0..cn (loop
+    invariant; storing them in the record measured no faster, see _ray_setup)."""
+    return [sympy.ff(k, m) * _sym(f"ray.c{k}") for k in range(m, n + 1)]
+
+
 def _derivative(n: int, m: int, x: sympy.Expr) -> sympy.Expr:
-    """F^(m) = sum_k k!/(k-m)! c_k x^(k-m) over the ray record's c0..cn, by Horner; the
-    products k!/(k-m)! c_k are loop invariant (a compiler hoists them out of the loop)."""
-    return _horner([sympy.ff(k, m) * _sym(f"ray.c{k}") for k in range(m, n + 1)], x)
+    """F^(m) at x by Horner."""
+    return _horner(_derivative_coefficients(n, m), x)
 
 
 def _estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol
@@ -468,41 +473,38 @@ def _estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol
     return (terms[0] if terms else sympy.S.Zero), powers
 
 
-def estrin_ops(degree: int) -> tuple[int, int]:
-    """(operations, of which the powers of s) of a degree-`degree` polynomial by Estrin's
-    scheme, the coefficients taken as given (`implc show`)."""
+def ray_quantity_ops(n: int, quantity: str) -> int:
+    """Operations of a ray quantity (dS, d2S) of a degree-n ray polynomial by Estrin's
+    scheme, its powers of s included, the coefficients taken as given (`implc show`)."""
+    degree = max(n - _DERIVATIVE_ORDER[quantity], 0)
     value, powers = _estrin([_sym(f"a{k}") for k in range(degree + 1)], _sym("s"))
-    power_ops = sum(count_ops(v) for _, v in powers)
-    return count_ops(value) + power_ops, power_ops
+    return count_ops(value) + sum(count_ops(v) for _, v in powers)
 
 
 def _estrin_derivative(n: int, m: int, x: sympy.Symbol):
-    """F^(m) over the ray record's c0..cn by Estrin's scheme: (value, its power lets)."""
-    return _estrin([sympy.ff(k, m) * _sym(f"ray.c{k}") for k in range(m, n + 1)], x)
+    """F^(m) at x by Estrin's scheme: (value, the lets of its powers of x)."""
+    return _estrin(_derivative_coefficients(n, m), x)
 
 
 def _lets(powers, printer) -> list[tuple[str, str, str]]:
+    """Printed lets (type, name, value) of (symbol, value) pairs."""
     return [("real", k.name, printer.doprint(v)) for k, v in powers]
 
 
 def _estrin_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
     """F' and/or F'' at march parameter s (measured from the ray record's origin, the
     expansion point), each by Estrin's scheme in s."""
-    s = _sym("s")
-    lets: dict[sympy.Symbol, sympy.Expr] = {}
+    powers: dict[sympy.Symbol, sympy.Expr] = {}  # s^2, s^4, ...: shared by F' and F''
     outputs = []
     for q in quantities:
-        m = _DERIVATIVE_ORDER[q]
-        value, powers = _estrin([sympy.ff(k, m) * _sym(f"ray.c{k}") for k in range(m, n + 1)],
-                                s)
-        lets.update(powers)
+        value, used = _estrin_derivative(n, _DERIVATIVE_ORDER[q], _sym("s"))
+        powers.update(used)
         outputs.append(printer.doprint(value))
     what = ", ".join(quantities)
     return ShaderFunction(_ray_name(quantities),
                           f"{what} at march parameter s: Estrin's scheme on the ray polynomial",
                           (("Ray", "ray"), ("real", "s")), _RETURN_TYPE[len(outputs)],
-                          tuple(("real", k.name, printer.doprint(v)) for k, v in lets.items()),
-                          tuple(outputs))
+                          tuple(_lets(powers.items(), printer)), tuple(outputs))
 
 
 # --- the exact method: root isolation on the ray polynomial ------------------------------
@@ -546,7 +548,7 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                ("int", K + "CRIT_STEPS", str(int(constants.crit_steps))))
     bottom = 2 if n >= 3 else 1
     m = n - bottom
-    closed = tuple(printer.doprint(sympy.ff(j + m, m) * c[j + m]) for j in range(bottom + 1))
+    closed = tuple(printer.doprint(v) for v in _derivative_coefficients(n, m))
     empty = Code((), ())
     return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
                    empty, Solver(n, bottom, closed), carried)

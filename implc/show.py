@@ -6,7 +6,7 @@ import sympy
 
 from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
-from .marcher import AUTO_MAX_DEGREE, coefficient_program, estrin_ops, evaluations
+from .marcher import AUTO_MAX_DEGREE, coefficient_program, evaluations, ray_quantity_ops
 from .methods import Method
 from .surface import Surface
 from .textform import to_text
@@ -65,8 +65,8 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
-    orders = {"dS": degree - 1, "d2S": max(degree - 2, 0)}
-    per_step = ", ".join(f"{q} {estrin_ops(orders[q])[0]}" for q in dict.fromkeys(quantities))
+    per_step = ", ".join(f"{q} {ray_quantity_ops(degree, q)}"
+                         for q in dict.fromkeys(quantities))
     point = [" + ".join(qs) for kind, qs in evaluations(method, "ray-poly")
              if kind == "point" and qs not in (("S",), ("grad",))]
     return [

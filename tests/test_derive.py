@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import sympy
 from cases import EXAMPLES
 
 from implc.derive import Derivatives
@@ -87,8 +88,6 @@ def test_optimized_program_equals_original(example, method):
 def test_sums_add_the_latest_term_last():
     """The Cross-Cap's t0 + x^2 + z, with t0 = y^2 + z^2 two operations deep: x^2 + z is
     summed while t0 is computed, and t0 comes last (3 operations on the path, not 4)."""
-    import sympy
-
     from implc.optimize import _sums_by_depth
 
     x, y, z, t0 = sympy.symbols("x y z t0", real=True)
@@ -103,8 +102,6 @@ def test_sums_add_the_latest_term_last():
 def test_no_sum_of_three_terms_is_printed_flat(example):
     """Every optimized sum is a tree of two-term sums (the pass of optimize.py that
     shortens a march step's dependency chain)."""
-    import sympy
-
     surface = load_surface(example)
     for name, program in build_functions(surface.expr, METHODS["hessian"]).items():
         for expr in (*(v for _, v in program.assignments), *program.outputs):
@@ -116,8 +113,6 @@ def test_no_sum_of_three_terms_is_printed_flat(example):
 def test_estrin_evaluates_the_polynomial(degree):
     """The marcher's F', F'' by Estrin's scheme (its powers s^2, s^4, ... as lets) are
     the polynomial: against numpy's Horner on random coefficients."""
-    import sympy
-
     from implc.marcher import _estrin
 
     rng = np.random.default_rng(degree)
