@@ -41,10 +41,11 @@ from .methods import (
     X0,
     X1,
     Constants,
+    H,
     Method,
     S,
 )
-from .optimize import Program, count_ops, optimize
+from .optimize import Program, arrange_by_depth, count_ops, optimize
 from .symbols import DIRECTION, POINT
 
 FORMS = ("point", "ray-poly")
@@ -56,6 +57,11 @@ EVAL_CHOICES = ("auto", *FORMS)
 # power chains). With Estrin's F', ray-poly measured as fast or faster up to degree 12 in
 # one run (RESULTS section 2); not re-decided on that alone.
 AUTO_MAX_DEGREE = 6
+
+# When the root test's inputs are ready, in operations (optimize.arrange_by_depth): the
+# start sample (F0, F0', X0) first, then the step length h (after the step rule), then the
+# end sample (F1, F1', X1), evaluated at s0 + h.
+_H_DEPTH, _LATE = 10, 1000
 
 QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
 # What the ray polynomial gives (by Estrin's scheme): F' and F''. F itself, whose sign is the
@@ -330,8 +336,16 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
 
     rule = method.root_rule(constants.taylor2)
     ends = {**ends0, **ends1}
-    root = Code(tuple(("real", s.name, show(v.xreplace(ends))) for s, v in rule.lets),
-                (show(rule.value.xreplace(ends)),), rule.what)
+
+    ready = {**dict.fromkeys(ends1.values(), _LATE), H: _H_DEPTH}
+
+    def arranged(expr: sympy.Basic) -> str:
+        # the end sample is computed last: products and sums take it last (arranged after
+        # every substitution, which would flatten the nesting again)
+        return printer.doprint(arrange_by_depth(expr.xreplace({**ends, **const_names}), ready))
+
+    root = Code(tuple(("real", s.name, arranged(v)) for s, v in rule.lets),
+                (arranged(rule.value),), rule.what)
 
     used = set().union(*(e.free_symbols for e in (*method.sample, method.step, rule.value,
                                                     *(v for _, v in rule.lets))))

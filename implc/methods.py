@@ -114,41 +114,65 @@ def eq2(f: sympy.Expr, df: sympy.Expr) -> sympy.Expr:
     return Piecewise((near, Abs(f) <= TAU1), (2 * STEP, Abs(f) > TAU2), (STEP, True))
 
 
-def interval_test(start: sympy.Expr, *values: sympy.Expr) -> sympy.Basic:
+def interval_test(start: sympy.Expr, *values: sympy.Expr, late: sympy.Expr = F1) -> sympy.Basic:
     """0 lies in [min, max] of `start` (the step's F0) and `values`.
 
-    Computed as min(sign(F0)·v) <= 0 over the other values, the same boolean: F0 > 0
-    makes max >= 0 hold already, so only min <= 0 is asked; F0 < 0 the mirror image;
-    F0 = 0 both hold, and sign 0 makes every product 0. Multiplying by sign(F0) (+1, -1
-    or 0) is exact in floating point, and F0 is known a step early. One reduction, not
-    two, on the march's dependency chain: 7-12 % a frame on llvmpipe (docs/RESULTS.md,
-    section 3)."""
+    Asked as "sign(F0)·v <= 0 for some v", the same boolean: F0 > 0 makes max >= 0 hold
+    already, so only min <= 0 is asked; F0 < 0 the mirror image; F0 = 0 both hold, and
+    sign 0 makes every product 0. A value that is the step's `late` sample plus other
+    terms, v = F1 + w, is asked as sign(F0)·F1 <= -sign(F0)·w, and those with F1 itself
+    as one bound: sign(F0)·F1 <= max(0, -sign(F0)·w, ...). The rest go into one
+    min(sign(F0)·v) <= 0.
+
+    Exact in floating point: sign(F0) is +1, -1 or 0, so its products are exact, and a
+    rounded sum F1 + w is <= 0 exactly when F1 <= -w (rounding is monotonic and a sum of
+    floats rounds to 0 only when it is 0), so the boolean is that of v evaluated as
+    F1 + w. F1 is the last value a march step computes; as a bound F1 is one comparison
+    from the answer, not a sum, a product and a reduction: 7-12 % a frame on llvmpipe for
+    the one reduction, and 5 % more for the bound (docs/RESULTS.md, section 3)."""
     sigma = sympy.sign(start)
-    return Min(*(sigma * v for v in values)) <= 0
+
+    def signed(v: sympy.Expr) -> sympy.Expr:  # sign(F0)*v, term by term (also exact)
+        return sympy.Add(*(sigma * term for term in sympy.Add.make_args(v)))
+
+    rest, bounds = [], []
+    for v in values:
+        w = v - late
+        if v.has(late) and not w.has(late):
+            bounds.append(signed(-w))
+        else:
+            rest.append(signed(v))
+    tests = [Min(*rest) <= 0] if rest else []
+    if bounds:
+        tests.append(sigma * late <= sympy.Max(*bounds))
+    return sympy.Or(*tests)
 
 
-Q, R = sympy.symbols("q r", real=True)
 U0, U1, M0, M1 = sympy.symbols("u0 u1 m0 m1", real=True)
+# how interval_test asks it, for the shader's comment
+_ASKED = ("; 0 in [min, max] of F0, q, r, F1 is asked as sign(F0) q <= 0 or "
+          "sign(F0) F1 <= max(0, sign(F0) (F1 - r))")
 
 # Eq. 3: first-order Taylor extension towards the midpoint from both ends.
-TAYLOR = Rule(interval_test(F0, Q, R, F1),
-              ((Q, F0 + D0 * H / 2), (R, F1 - D1 * H / 2)),
-              "Eq. 3: first-order Taylor extension towards the midpoint from both ends")
+TAYLOR = Rule(interval_test(F0, F0 + D0 * H / 2, F1 - D1 * H / 2, F1),
+              what="Eq. 3: first-order Taylor extension towards the midpoint from both ends"
+              + _ASKED)
 # Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
-EQ4_PAPER = Rule(interval_test(F0, Q, R, F1),
-                 ((Q, F0 + D0 * H / 2 + X0 * H**2 / 2), (R, F1 - D1 * H / 2 + X0 * H**2 / 2)),
-                 "Eq. 4 as printed: F''(t0) in both q and r, with h^2/2")
+EQ4_PAPER = Rule(interval_test(F0, F0 + D0 * H / 2 + X0 * H**2 / 2,
+                               F1 - D1 * H / 2 + X0 * H**2 / 2, F1),
+                 what="Eq. 4 as printed: F''(t0) in both q and r, with h^2/2" + _ASKED)
 # Eq. 4, consistent reading: second-order Taylor to the midpoint, (h/2)^2/2 = h^2/8.
-_CONSISTENT_LETS = ((Q, F0 + D0 * H / 2 + X0 * H**2 / 8), (R, F1 - D1 * H / 2 + X1 * H**2 / 8))
-EQ4_CONSISTENT = Rule(interval_test(F0, Q, R, F1), _CONSISTENT_LETS,
-                      "Eq. 4, consistent reading: second-order Taylor to the midpoint, "
-                      "(h/2)^2/2 = h^2/8, F''(t1) in r")
+_Q_CONSISTENT = F0 + D0 * H / 2 + X0 * H**2 / 8
+_R_CONSISTENT = F1 - D1 * H / 2 + X1 * H**2 / 8
+EQ4_CONSISTENT = Rule(interval_test(F0, _Q_CONSISTENT, _R_CONSISTENT, F1),
+                      what="Eq. 4, consistent reading: second-order Taylor to the midpoint, "
+                      "(h/2)^2/2 = h^2/8, F''(t1) in r" + _ASKED)
 # implc's extension: also the extremum of each end's quadratic model inside the step,
 # F(t0 + u) ~ F0 + F0' u + F0'' u^2/2 at u = -F0'/F0'' (and alike from t1), so a dip of F
 # below zero between the ends (two close crossings) is seen too.
 EQ4_EXTREMUM = Rule(
-    interval_test(F0, Q, R, F1, M0, M1),
-    _CONSISTENT_LETS + (
+    interval_test(F0, _Q_CONSISTENT, _R_CONSISTENT, F1, M0, M1),
+    (
         (U0, Piecewise((-D0 / X0, Ne(X0, 0)), (-1, True))),
         (U1, Piecewise((D1 / X1, Ne(X1, 0)), (-1, True))),
         (M0, Piecewise((F0 + D0 * U0 / 2, (U0 > 0) & (U0 < H)), (F0, True))),

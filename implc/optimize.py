@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import heapq
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import sympy
@@ -164,35 +164,52 @@ def _sums_by_depth(assignments, outputs, inputs):
     `t0 + x_2 + z`. Ties keep sympy's canonical order, so the output stays
     deterministic."""
     depth: dict[sympy.Basic, int] = dict.fromkeys(inputs, 0)
-
-    def visit(node: sympy.Expr) -> tuple[sympy.Expr, int]:
-        if node.is_Atom:
-            return node, depth.get(node, 0)
-        parts = [visit(a) for a in node.args]
-        if node.is_Add and len(parts) > 2:
-            return _huffman_sum(parts)
-        args = (e for e, _ in parts)
-        # unevaluated: 4*(a + (b + c)) would distribute, a product would flatten a sum
-        rebuilt = node.func(*args, evaluate=False) if node.is_Add or node.is_Mul \
-            else node.func(*args)
-        return rebuilt, max((d for _, d in parts), default=0) + 1
-
     new_assignments = []
     for sym, value in assignments:
-        value, depth[sym] = visit(value)
+        value, depth[sym] = _by_depth(value, depth, products=False)
         new_assignments.append((sym, value))
-    return new_assignments, [visit(o)[0] for o in outputs]
+    return new_assignments, [_by_depth(o, depth, products=False)[0] for o in outputs]
 
 
-def _huffman_sum(parts: list[tuple[sympy.Expr, int]]) -> tuple[sympy.Expr, int]:
-    """The terms' sum as a tree merging the two shallowest first; (sum, its depth)."""
+def arrange_by_depth(expr: sympy.Basic, depth: Mapping[sympy.Basic, int]) -> sympy.Basic:
+    """`expr` with every sum and product of three or more operands nested so that the
+    operands ready first (by `depth`, in operations; 0 if absent) are combined first and
+    the latest one last. For code whose inputs arrive at different times: in a march
+    step's root test the end sample (F1, F1') comes last, so `F1' h/2 sign(F0)` is
+    better written `F1' (h/2 sign(F0))`, one product after F1', not three."""
+    return _by_depth(expr, dict(depth), products=True)[0]
+
+
+def _by_depth(node, depth: dict, products: bool) -> tuple[sympy.Basic, int]:
+    """(node arranged by depth, its depth); see `_sums_by_depth`, `arrange_by_depth`."""
+    if node.is_Atom:
+        return node, depth.get(node, 0)
+    parts = [_by_depth(a, depth, products) for a in node.args]
+    if node.is_Add and len(parts) > 2:
+        return _huffman(parts, sympy.Add)
+    if products and node.is_Mul and len(parts) > 2:
+        coeff, _ = node.as_coeff_Mul()
+        if coeff.is_negative:  # the sign stays outside: -(a*(b*c)), one negation
+            product, d = _by_depth(-node, depth, products)
+            return sympy.Mul(sympy.S.NegativeOne, product, evaluate=False), d + 1
+        return _huffman(parts, sympy.Mul)
+    args = (e for e, _ in parts)
+    # unevaluated: 4*(a + (b + c)) would distribute, a product would flatten a sum
+    rebuilt = node.func(*args, evaluate=False) if node.is_Add or node.is_Mul \
+        else node.func(*args)
+    return rebuilt, max((d for _, d in parts), default=0) + 1
+
+
+def _huffman(parts: list[tuple[sympy.Expr, int]], op) -> tuple[sympy.Expr, int]:
+    """The operands combined by `op` (Add or Mul) as a tree merging the two shallowest
+    first; (result, its depth)."""
     heap = [(d, k, e) for k, (e, d) in enumerate(parts)]
     heapq.heapify(heap)
     order = len(heap)
     while len(heap) > 1:
         da, _, a = heapq.heappop(heap)
         db, _, b = heapq.heappop(heap)
-        heapq.heappush(heap, (max(da, db) + 1, order, sympy.Add(a, b, evaluate=False)))
+        heapq.heappush(heap, (max(da, db) + 1, order, op(a, b, evaluate=False)))
         order += 1
     depth, _, total = heap[0]
     return total, depth

@@ -14,6 +14,7 @@ from implc.methods import METHODS
 from implc.numeric import evaluate, evaluate_program
 from implc.surface import load_surface
 from implc.symbols import DIRECTION, POINT
+from implc.targets import get_target
 
 N = 128  # random points per example
 
@@ -97,6 +98,24 @@ def test_sums_add_the_latest_term_last():
     for target in ("glsl", "wgsl", "opencl"):
         text = emit(load_surface("cross-cap"), target, "taylor", METHODS["taylor"].defaults)
         assert "*(t0 + (x_2 + z))" in text, target
+
+def test_products_take_the_latest_factor_last():
+    """arrange_by_depth: F1' h/2 sign(F0) with F1' ready last is (h/2 sign(F0)) F1', one
+    product after F1'; a negative coefficient stays outside; the value is unchanged."""
+    from implc.optimize import arrange_by_depth
+
+    a, b, late = sympy.symbols("a b late", real=True)
+    sign = sympy.sign(a)
+    for expr in (sympy.Rational(1, 2) * b * late * sign, -b * late * sign):
+        out = arrange_by_depth(expr, {late: 1000})
+        product = out.args[1] if out.args[0] == -1 else out
+        assert product.is_Mul and len(product.args) == 2 and late in product.args, out
+        env = {a: np.array([-2.0, 3.0]), b: np.array([0.5, -7.0]), late: np.array([3.0, 5.0])}
+        np.testing.assert_array_equal(evaluate(out, env), evaluate(expr, env))
+    text = get_target("glsl").printer().doprint(
+        arrange_by_depth(sympy.Rational(1, 2) * b * late * sign, {late: 1000, b: 10}))
+    assert text.endswith("*late") and text.count("late") == 1, text
+
 
 @pytest.mark.parametrize("example", EXAMPLES)
 def test_no_sum_of_three_terms_is_printed_flat(example):

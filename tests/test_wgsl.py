@@ -129,7 +129,7 @@ def test_every_option_reaches_the_shader():
                 assert (line in text) == (method != "curvature"), (method, line)
             assert ("const EPS: f32 = 0.0002f;" in text) == (method == "hessian-approx")
             if method in ("hessian", "hessian-approx"):
-                assert ("0.125f*f1.z*h*h" in text) == (taylor2 == "consistent")
+                assert ("0.125f*sign(f0.x)*h*h*f1.z" in text) == (taylor2 == "consistent")
             name = f"steiner.{method}.{taylor2}.wgsl"
             verdict = validate(text, name)
             assert verdict.ok, verdict.render(name)
@@ -150,8 +150,8 @@ def test_printer_types_literals_and_refuses_what_wgsl_cannot_say():
 def test_validator_points_into_the_users_file(monkeypatch):
     text = _emit("cross-cap", "taylor", "paper", "program")
     lines = text.splitlines()
-    line = next(i for i, t in enumerate(lines, 1) if "q*sign(f0.x)" in t)
-    broken = text.replace("q*sign(f0.x)", "q*sign(f0.w)")
+    line = next(i for i, t in enumerate(lines, 1) if "f1.x*sign(f0.x)" in t)
+    broken = text.replace("f1.x*sign(f0.x)", "f1.x*sign(f0.w)")
     verdict = validate(broken, "mine/cc.wgsl")
     assert not verdict.ok
     assert f"mine/cc.wgsl:{line}:" in verdict.messages, verdict.messages

@@ -67,6 +67,10 @@ class ShaderPrinterMixin:
         for factor in sympy.Mul.make_args(rest) if rest != 1 else ():
             if factor.is_Pow and factor.exp.is_Rational and factor.exp.is_negative:
                 den.append(sympy.Pow(factor.base, -factor.exp, evaluate=factor.exp != -1))
+            elif factor.is_Mul and num:
+                # a product left unevaluated inside a product fixes the order of
+                # multiplication (optimize.arrange_by_depth): a*(b*c), not a*b*c
+                num.append(f"({self._print(factor)})")
             else:
                 num.append(self.parenthesize(factor, prec))
         text = "*".join(num) if num else self.float_literal(1.0)

@@ -162,11 +162,10 @@ float step_size(Ray ray, float s, vec3 f0) {
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
-// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2.
+// Eq. 4 as printed: F''(t0) in both q and r, with h^2/2; 0 in [min, max] of F0, q, r, F1
+// is asked as sign(F0) q <= 0 or sign(F0) F1 <= max(0, sign(F0) (F1 - r)).
 bool root_in(vec3 f0, vec3 f1, float h) {
-    float q = f0.x + 0.5*f0.y*h + 0.5*f0.z*h*h;
-    float r = 0.5*f0.z*h*h + f1.x - 0.5*f1.y*h;
-    return min(min(f1.x*sign(f0.x), q*sign(f0.x)), r*sign(f0.x)) <= 0.0;
+    return (sign(f0.x)*(0.5*f0.z)*h*h + (f0.x*sign(f0.x) + sign(f0.x)*(0.5*f0.y)*h)) <= 0.0 || f1.x*sign(f0.x) <= max(0.0, 0.5*sign(f0.x)*h*f1.y - sign(f0.x)*(0.5*f0.z)*h*h);
 }
 
 // Newton safeguarded by bisection inside [a, b]: a Newton step that leaves the bracket
