@@ -337,15 +337,14 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     rule = method.root_rule(constants.taylor2)
     ends = {**ends0, **ends1}
 
-    ready = {**dict.fromkeys(ends1.values(), _LATE), H: _H_DEPTH}
-
-    def arranged(expr: sympy.Basic) -> str:
-        # the end sample is computed last: products and sums take it last (arranged after
-        # every substitution, which would flatten the nesting again)
-        return printer.doprint(arrange_by_depth(expr.xreplace({**ends, **const_names}), ready))
-
-    root = Code(tuple(("real", s.name, arranged(v)) for s, v in rule.lets),
-                (arranged(rule.value),), rule.what)
+    # the end sample is computed last: products and sums take it last (arranged after
+    # every substitution, which would flatten the nesting again)
+    names = {**ends, **const_names}
+    lets, value = arrange_by_depth([(s, v.xreplace(names)) for s, v in rule.lets],
+                                   rule.value.xreplace(names),
+                                   {**dict.fromkeys(ends1.values(), _LATE), H: _H_DEPTH})
+    root = Code(tuple(("real", s.name, printer.doprint(v)) for s, v in lets),
+                (printer.doprint(value),), rule.what)
 
     used = set().union(*(e.free_symbols for e in (*method.sample, method.step, rule.value,
                                                     *(v for _, v in rule.lets))))

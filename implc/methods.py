@@ -129,7 +129,7 @@ def interval_test(start: sympy.Expr, *values: sympy.Expr, late: sympy.Expr = F1)
     floats rounds to 0 only when it is 0), so the boolean is that of v evaluated as
     F1 + w. F1 is the last value a march step computes; as a bound F1 is one comparison
     from the answer, not a sum, a product and a reduction: 7-12 % a frame on llvmpipe for
-    the one reduction, and 5 % more for the bound (docs/RESULTS.md, section 3)."""
+    the one reduction, and 4-10 % more for the bound (docs/RESULTS.md, section 3)."""
     sigma = sympy.sign(start)
 
     def signed(v: sympy.Expr) -> sympy.Expr:  # sign(F0)*v, term by term (also exact)
@@ -148,7 +148,7 @@ def interval_test(start: sympy.Expr, *values: sympy.Expr, late: sympy.Expr = F1)
     return sympy.Or(*tests)
 
 
-U0, U1, M0, M1 = sympy.symbols("u0 u1 m0 m1", real=True)
+U0, U1, M0 = sympy.symbols("u0 u1 m0", real=True)
 # how interval_test asks it, for the shader's comment
 _ASKED = ("; 0 in [min, max] of F0, q, r, F1 is asked as sign(F0) q <= 0 or "
           "sign(F0) F1 <= max(0, sign(F0) (F1 - r))")
@@ -170,13 +170,14 @@ EQ4_CONSISTENT = Rule(interval_test(F0, _Q_CONSISTENT, _R_CONSISTENT, F1),
 # implc's extension: also the extremum of each end's quadratic model inside the step,
 # F(t0 + u) ~ F0 + F0' u + F0'' u^2/2 at u = -F0'/F0'' (and alike from t1), so a dip of F
 # below zero between the ends (two close crossings) is seen too.
+# (m1 is F1 minus a term, so that interval_test can ask it as a bound on F1 too)
 EQ4_EXTREMUM = Rule(
-    interval_test(F0, _Q_CONSISTENT, _R_CONSISTENT, F1, M0, M1),
+    interval_test(F0, _Q_CONSISTENT, _R_CONSISTENT, F1, M0,
+                  F1 - Piecewise((D1 * U1 / 2, (U1 > 0) & (U1 < H)), (0, True))),
     (
         (U0, Piecewise((-D0 / X0, Ne(X0, 0)), (-1, True))),
         (U1, Piecewise((D1 / X1, Ne(X1, 0)), (-1, True))),
         (M0, Piecewise((F0 + D0 * U0 / 2, (U0 > 0) & (U0 < H)), (F0, True))),
-        (M1, Piecewise((F1 - D1 * U1 / 2, (U1 > 0) & (U1 < H)), (F1, True))),
     ),
     "Eq. 4 consistent, plus implc's extension: the extremum of each end's quadratic model "
     "inside the step",

@@ -171,13 +171,20 @@ def _sums_by_depth(assignments, outputs, inputs):
     return new_assignments, [_by_depth(o, depth, products=False)[0] for o in outputs]
 
 
-def arrange_by_depth(expr: sympy.Basic, depth: Mapping[sympy.Basic, int]) -> sympy.Basic:
-    """`expr` with every sum and product of three or more operands nested so that the
-    operands ready first (by `depth`, in operations; 0 if absent) are combined first and
-    the latest one last. For code whose inputs arrive at different times: in a march
-    step's root test the end sample (F1, F1') comes last, so `F1' h/2 sign(F0)` is
-    better written `F1' (h/2 sign(F0))`, one product after F1', not three."""
-    return _by_depth(expr, dict(depth), products=True)[0]
+def arrange_by_depth(lets: Sequence[tuple[sympy.Symbol, sympy.Basic]], value: sympy.Basic,
+                     depth: Mapping[sympy.Basic, int]):
+    """Straight-line code (`lets` in order, then `value`) with every sum and product of
+    three or more operands nested so that the operands ready first (by `depth`, in
+    operations; 0 if absent; a let as deep as its value) are combined first and the
+    latest one last. For code whose inputs arrive at different times: in a march step's
+    root test the end sample (F1, F1') comes last, so `F1' h/2 sign(F0)` is better
+    written `(h/2 sign(F0)) F1'`, one product after F1', not three. Returns (lets, value)."""
+    ready = dict(depth)
+    arranged = []
+    for sym, expr in lets:
+        expr, ready[sym] = _by_depth(expr, ready, products=True)
+        arranged.append((sym, expr))
+    return arranged, _by_depth(value, ready, products=True)[0]
 
 
 def _by_depth(node, depth: dict, products: bool) -> tuple[sympy.Basic, int]:

@@ -107,13 +107,13 @@ def test_products_take_the_latest_factor_last():
     a, b, late = sympy.symbols("a b late", real=True)
     sign = sympy.sign(a)
     for expr in (sympy.Rational(1, 2) * b * late * sign, -b * late * sign):
-        out = arrange_by_depth(expr, {late: 1000})
+        out = arrange_by_depth([], expr, {late: 1000})[1]
         product = out.args[1] if out.args[0] == -1 else out
         assert product.is_Mul and len(product.args) == 2 and late in product.args, out
         env = {a: np.array([-2.0, 3.0]), b: np.array([0.5, -7.0]), late: np.array([3.0, 5.0])}
         np.testing.assert_array_equal(evaluate(out, env), evaluate(expr, env))
     text = get_target("glsl").printer().doprint(
-        arrange_by_depth(sympy.Rational(1, 2) * b * late * sign, {late: 1000, b: 10}))
+        arrange_by_depth([], sympy.Rational(1, 2) * b * late * sign, {late: 1000, b: 10})[1])
     assert text.endswith("*late") and text.count("late") == 1, text
 
 
