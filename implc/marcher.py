@@ -221,7 +221,6 @@ def evaluations(method: Method, form: str) -> list[tuple[str, tuple[str, ...]]]:
     shading, library users) first."""
     wanted = [("point", ("S",)), ("point", ("grad",))]
     sets = [*_sample_groups(method).values(), REFINE_SET]
-    sets += [(RAY_QUANTITIES[a.func.__name__],) for a in _applications(method.step)]
     for quantities in sets:
         for call in _split(quantities, form):
             if call not in wanted:
@@ -325,14 +324,9 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     calls(REFINE_SET, S, "e", lets, replace)
     fd = Code(tuple(lets), tuple(show(_apply(q, S).xreplace(replace)) for q in REFINE_SET))
 
-    # step rule: a ray quantity in it is evaluated inline, on the branch that reads it
     ends0 = {F0: _sym("f0.x"), D0: _sym("f0.y"), X0: _sym("f0.z")}
     ends1 = {F1: _sym("f1.x"), D1: _sym("f1.y"), X1: _sym("f1.z")}
-    inline = {}
-    for app in _applications(method.step):
-        single = (RAY_QUANTITIES[app.func.__name__],)
-        inline[app] = _sym(call(_split(single, form)[0][0], single, app.args[0]))
-    step = Code((), (show(method.step.xreplace({**ends0, **inline})),))
+    step = Code((), (show(method.step.xreplace(ends0)),))
 
     rule = method.root_rule(constants.taylor2)
     ends = {**ends0, **ends1}

@@ -4,8 +4,8 @@ A method is three sympy expressions (DESIGN.md section 4):
 - `sample`: what it evaluates at a march point s, a triple (F, F', X) built from the ray
   quantities F(s), dF(s), d2F(s) and lap(s) (X is the method's extra value, 0 if none);
 - `step`: the step length at the start of a step, a Piecewise over that end's sample
-  (F0, D0, X0) and the constants; a ray quantity in it (the `sign` method's F') is
-  evaluated only on the branch that reads it;
+  (F0, D0, X0) and the constants only (a value it reads is carried from the step before,
+  off the loop's dependency chain);
 - `root`: does [s0, s0 + h] hold a root? A `Rule` (named intermediate values, then a
   boolean) over both ends' samples (F0, D0, X0), (F1, D1, X1) and h.
 The marcher skeleton (templates/marcher.j2) is the same for every method, and the target
@@ -108,8 +108,7 @@ class Rule:
 # --- the pieces the paper's methods are made of --------------------------------------
 
 def eq2(f: sympy.Expr, df: sympy.Expr) -> sympy.Expr:
-    """Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b.
-    `df` is read only when |f| <= tau1 (nested, so a lazily evaluated F' stays lazy)."""
+    """Eq. 2: b/4 near the surface at a silhouette, b/2 near it, 2b far from it, else b."""
     near = Piecewise((STEP / 4, Abs(df) <= TAU3), (STEP / 2, True))
     return Piecewise((near, Abs(f) <= TAU1), (2 * STEP, Abs(f) > TAU2), (STEP, True))
 
@@ -218,8 +217,11 @@ METHODS: dict[str, Method] = {
     m.name: m
     for m in (
         Method("sign", "Eq. 2 steps; root where F changes sign between step ends",
-               # F' is needed only near the surface: the step rule evaluates it there
-               (F(S), sympy.S.Zero, sympy.S.Zero), eq2(F0, DF(S)),
+               # F' is sampled with F, though Eq. 2 reads it only near the surface:
+               # evaluated inside the step rule, on the branch that reads it, it was on
+               # the loop's chain (a masked branch costs every lane) and measured 10-40 %
+               # slower a frame (docs/RESULTS.md, section 3)
+               (F(S), DF(S), sympy.S.Zero), eq2(F0, D0),
                Rule(F0 * F1 < 0, what="the sign test: F changes sign between the ends")),
         Method("taylor", "Eq. 2 steps; first-order Taylor interval test (Eq. 3)",
                (F(S), DF(S), sympy.S.Zero), eq2(F0, D0), TAYLOR,

@@ -112,3 +112,20 @@ def test_interval_test_is_zero_in_min_max():
     want = (values.min(axis=0) <= 0) & (values.max(axis=0) >= 0)
     assert (got == want).all(), int((got != want).sum())
     assert want.any() and not want.all()
+
+
+def test_step_rules_read_only_the_start_sample():
+    """A step rule reads the carried start sample (F0, F0', X0) and constants, never a ray
+    quantity of its own: one evaluated inside the rule sits on the march loop's chain
+    (the `sign` method's lazy F' measured 10-40 % a frame)."""
+    import sympy
+
+    from implc.methods import CONSTANT_SYMBOLS, D0, F0, X0
+
+    for method in METHODS.values():
+        if method.solves:
+            continue
+        calls = [a for a in sympy.preorder_traversal(method.step)
+                 if isinstance(a, sympy.core.function.AppliedUndef)]
+        assert not calls, (method.name, calls)
+        assert method.step.free_symbols <= {F0, D0, X0, *CONSTANT_SYMBOLS}, method.name

@@ -118,8 +118,9 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is
 // s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
 vec3 values_at(Ray ray, float s, float s0, float h) {
-    float e0 = S((ray.o + s0*ray.d) + h*ray.d);
-    return vec3(e0, 0.0, 0.0);
+    float e0 = ray_dS(ray, s);
+    float e1 = S((ray.o + s0*ray.d) + h*ray.d);
+    return vec3(e1, e0, 0.0);
 }
 
 // (F, F') at s, for the refinement.
@@ -131,7 +132,7 @@ vec2 fd(Ray ray, float s) {
 
 // The step length at s, from the sample f0 there.
 float step_size(Ray ray, float s, vec3 f0) {
-    return (TAU1 >= abs(f0.x) ? (TAU3 >= abs(ray_dS(ray, s)) ? 0.25*STEP : 0.5*STEP) : (TAU2 < abs(f0.x) ? 2.0*STEP : STEP));
+    return (TAU1 >= abs(f0.x) ? (TAU3 >= abs(f0.y) ? 0.25*STEP : 0.5*STEP) : (TAU2 < abs(f0.x) ? 2.0*STEP : STEP));
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.

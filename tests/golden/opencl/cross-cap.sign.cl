@@ -119,8 +119,9 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is
 // s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
 float3 values_at(Ray ray, float s, float s0, float h) {
-    float e0 = S((ray.o + s0*ray.d) + h*ray.d);
-    return (float3)(e0, 0.0f, 0.0f);
+    float e0 = ray_dS(ray, s);
+    float e1 = S((ray.o + s0*ray.d) + h*ray.d);
+    return (float3)(e1, e0, 0.0f);
 }
 
 // (F, F') at s, for the refinement.
@@ -132,7 +133,7 @@ float2 fd(Ray ray, float s) {
 
 // The step length at s, from the sample f0 there.
 float step_size(Ray ray, float s, float3 f0) {
-    return (TAU1 >= fabs(f0.x) ? (TAU3 >= fabs(ray_dS(ray, s)) ? 0.25f*STEP : 0.5f*STEP) : (TAU2 < fabs(f0.x) ? 2.0f*STEP : STEP));
+    return (TAU1 >= fabs(f0.x) ? (TAU3 >= fabs(f0.y) ? 0.25f*STEP : 0.5f*STEP) : (TAU2 < fabs(f0.x) ? 2.0f*STEP : STEP));
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.

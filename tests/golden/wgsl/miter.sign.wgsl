@@ -130,8 +130,9 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is
 // s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
 fn values_at(ray: Ray, s: f32, s0: f32, h: f32) -> vec3<f32> {
-    let e0: f32 = S((ray.o + s0*ray.d) + h*ray.d);
-    return vec3<f32>(e0, 0.0f, 0.0f);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S((ray.o + s0*ray.d) + h*ray.d);
+    return vec3<f32>(e1, e0, 0.0f);
 }
 
 // (F, F') at s, for the refinement.
@@ -143,7 +144,7 @@ fn fd(ray: Ray, s: f32) -> vec2<f32> {
 
 // The step length at s, from the sample f0 there.
 fn step_size(ray: Ray, s: f32, f0: vec3<f32>) -> f32 {
-    return select(select(STEP, 2.0f*STEP, TAU2 < abs(f0.x)), select(0.5f*STEP, 0.25f*STEP, TAU3 >= abs(ray_dS(ray, s))), TAU1 >= abs(f0.x));
+    return select(select(STEP, 2.0f*STEP, TAU2 < abs(f0.x)), select(0.5f*STEP, 0.25f*STEP, TAU3 >= abs(f0.y)), TAU1 >= abs(f0.x));
 }
 
 // Does [s0, s0 + h] hold a root? f0, f1 are the samples at its ends.
