@@ -90,7 +90,7 @@ bench-baseline: setup
 forms: setup
 	$(PY) scripts/eval_forms.py accuracy --size 512 cross-cap miter steiner roman torus tooth \
 	  sphere kummer cayley clebsch ding-dong whitney-umbrella barth-sextic heart
-	$(PY) scripts/eval_forms.py sweep --size 256 --methods taylor --plot docs/cost-growth.png
+	$(PY) scripts/eval_forms.py sweep --size 256 --frames 15 --methods taylor --plot docs/cost-growth.png
 
 # Fuzzing (tests/test_fuzz.py) at FUZZ_SCALE times the short pass that `make test` runs
 # (FUZZ_PATH_SCALE for the slower whole-path tests), a fresh seed each run: 100,000+
