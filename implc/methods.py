@@ -179,7 +179,8 @@ EQ4_EXTREMUM = Rule(
         (M0, Piecewise((F0 + D0 * U0 / 2, (U0 > 0) & (U0 < H)), (F0, True))),
     ),
     "Eq. 4 consistent, plus implc's extension: the extremum of each end's quadratic model "
-    "inside the step",
+    "inside the step; 0 in [min, max] of F0, q, r, F1, m0, m1 is asked as "
+    "sign(F0) min(q, m0) <= 0 or sign(F0) F1 <= max(0, sign(F0) (F1 - r), sign(F0) (F1 - m1))",
 )
 EQ4 = {"paper": EQ4_PAPER, "consistent": EQ4_CONSISTENT, "extremum": EQ4_EXTREMUM}
 
