@@ -172,7 +172,8 @@ def _sums_by_depth(assignments, outputs, inputs):
 
 
 def arrange_by_depth(lets: Sequence[tuple[sympy.Symbol, sympy.Basic]], value: sympy.Basic,
-                     depth: Mapping[sympy.Basic, int]):
+                     depth: Mapping[sympy.Basic, int],
+                     ) -> tuple[list[tuple[sympy.Symbol, sympy.Basic]], sympy.Basic]:
     """Straight-line code (`lets` in order, then `value`) with every sum and product of
     three or more operands nested so that the operands ready first (by `depth`, in
     operations; 0 if absent; a let as deep as its value) are combined first and the
