@@ -163,12 +163,7 @@ def _sums_by_depth(assignments, outputs, inputs):
     chain (docs/RESULTS.md, section 3): the Cross-Cap's S ends in `t0 + (x_2 + z)`, not
     `t0 + x_2 + z`. Ties keep sympy's canonical order, so the output stays
     deterministic."""
-    depth: dict[sympy.Basic, int] = dict.fromkeys(inputs, 0)
-    new_assignments = []
-    for sym, value in assignments:
-        value, depth[sym] = _by_depth(value, depth, products=False)
-        new_assignments.append((sym, value))
-    return new_assignments, [_by_depth(o, depth, products=False)[0] for o in outputs]
+    return _arrange(assignments, outputs, dict.fromkeys(inputs, 0), products=False)
 
 
 def arrange_by_depth(lets: Sequence[tuple[sympy.Symbol, sympy.Basic]], value: sympy.Basic,
@@ -180,26 +175,32 @@ def arrange_by_depth(lets: Sequence[tuple[sympy.Symbol, sympy.Basic]], value: sy
     latest one last. For code whose inputs arrive at different times: in a march step's
     root test the end sample (F1, F1') comes last, so `F1' h/2 sign(F0)` is better
     written `(h/2 sign(F0)) F1'`, one product after F1', not three. Returns (lets, value)."""
-    ready = dict(depth)
+    lets, (value,) = _arrange(lets, [value], dict(depth), products=True)
+    return lets, value
+
+
+def _arrange(lets, outputs, depth: dict, products: bool):
+    """`lets` and `outputs` arranged by depth, each let given the depth of its value."""
     arranged = []
     for sym, expr in lets:
-        expr, ready[sym] = _by_depth(expr, ready, products=True)
+        expr, depth[sym] = _by_depth(expr, depth, products)
         arranged.append((sym, expr))
-    return arranged, _by_depth(value, ready, products=True)[0]
+    return arranged, [_by_depth(o, depth, products)[0] for o in outputs]
 
 
 def _by_depth(node, depth: dict, products: bool) -> tuple[sympy.Basic, int]:
     """(node arranged by depth, its depth); see `_sums_by_depth`, `arrange_by_depth`."""
     if node.is_Atom:
         return node, depth.get(node, 0)
+    ordered_product = products and node.is_Mul and len(node.args) > 2
+    if ordered_product and node.as_coeff_Mul()[0].is_negative:
+        # the sign stays outside: -(a*(b*c)), one negation
+        product, d = _by_depth(-node, depth, products)
+        return sympy.Mul(sympy.S.NegativeOne, product, evaluate=False), d + 1
     parts = [_by_depth(a, depth, products) for a in node.args]
     if node.is_Add and len(parts) > 2:
         return _huffman(parts, sympy.Add)
-    if products and node.is_Mul and len(parts) > 2:
-        coeff, _ = node.as_coeff_Mul()
-        if coeff.is_negative:  # the sign stays outside: -(a*(b*c)), one negation
-            product, d = _by_depth(-node, depth, products)
-            return sympy.Mul(sympy.S.NegativeOne, product, evaluate=False), d + 1
+    if ordered_product:
         return _huffman(parts, sympy.Mul)
     args = (e for e, _ in parts)
     # unevaluated: 4*(a + (b + c)) would distribute, a product would flatten a sum
