@@ -8,15 +8,19 @@ At the test's 128^2 the same holds; the thresholds allow one pixel of float32 sl
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
+import sympy
 from cases import PAPER
 from conftest import require_gl
 
 from implc.emit import emit
-from implc.methods import METHODS, TAYLOR2_CHOICES
+from implc.methods import CONSTANT_SYMBOLS, D0, F0, METHODS, TAYLOR2_CHOICES, X0, interval_test
 from implc.metrics import compare
+from implc.numeric import evaluate
 from implc.render.run import render
 from implc.surface import load_surface
+from implc.targets import get_target
 from implc.validate import validate_text
 
 SIZE = 128
@@ -52,10 +56,6 @@ def test_extremum_matches_the_exact_reference(example):
 def test_min_and_max_print_as_balanced_trees(target):
     """A root test's min/max over four values is two levels deep, not three: the march
     loop is bound by its dependency chain (docs/RESULTS.md, generated vs hand-written)."""
-    import sympy
-
-    from implc.targets import get_target
-
     a, b, c, d, e = sympy.symbols("a b c d e", real=True)
     printer = get_target(target).printer()
     name = printer.known_functions["Max"]
@@ -70,8 +70,6 @@ def test_root_test_takes_the_end_sample_last(target):
     """The end sample (F1, F1') is what a march step computes last: F1 is one comparison
     from the root test's answer, F1' one product (optimize.arrange_by_depth), and the
     values free of F1 are one min (docs/RESULTS.md, section 3)."""
-    from implc.targets import get_target
-
     printer = get_target(target).printer()
     sign, high = printer.known_functions["sign"], printer.known_functions["Max"]
     for method in ("taylor", "hessian"):
@@ -87,12 +85,6 @@ def test_interval_test_is_zero_in_min_max():
     sign(F0) F1 <= max(0, -sign(F0) w) over those that are F1 + w, is the paper's
     0 in [min, max] of F0, q, r = F1 + w rounded to float32, and F1: on values with
     zeros, ties, cancellations and signs mixed."""
-    import numpy as np
-    import sympy
-
-    from implc.methods import interval_test
-    from implc.numeric import evaluate
-
     rng = np.random.default_rng(3)
     n = 40000
     picks = rng.choice([-2.0, -1e-30, 0.0, 1e-30, 0.5, 3.0], size=(4, n))
@@ -118,10 +110,6 @@ def test_step_rules_read_only_the_start_sample():
     """A step rule reads the carried start sample (F0, F0', X0) and constants, never a ray
     quantity of its own: one evaluated inside the rule sits on the march loop's chain
     (the `sign` method's lazy F' measured 10-40 % a frame)."""
-    import sympy
-
-    from implc.methods import CONSTANT_SYMBOLS, D0, F0, X0
-
     for method in METHODS.values():
         if method.solves:
             continue
