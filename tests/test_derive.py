@@ -10,8 +10,10 @@ from cases import EXAMPLES
 
 from implc.derive import Derivatives
 from implc.emit import build_functions, emit, function_quantities
+from implc.marcher import _estrin
 from implc.methods import METHODS
 from implc.numeric import evaluate, evaluate_program
+from implc.optimize import _sums_by_depth, arrange_by_depth
 from implc.surface import load_surface
 from implc.symbols import DIRECTION, POINT
 from implc.targets import get_target
@@ -89,8 +91,6 @@ def test_optimized_program_equals_original(example, method):
 def test_sums_add_the_latest_term_last():
     """The Cross-Cap's t0 + x^2 + z, with t0 = y^2 + z^2 two operations deep: x^2 + z is
     summed while t0 is computed, and t0 comes last (3 operations on the path, not 4)."""
-    from implc.optimize import _sums_by_depth
-
     x, y, z, t0 = sympy.symbols("x y z t0", real=True)
     assignments, (out,) = _sums_by_depth([(t0, y * y + z * z)], [t0 + x * x + z], (x, y, z))
     assert assignments == [(t0, y * y + z * z)]
@@ -102,8 +102,6 @@ def test_sums_add_the_latest_term_last():
 def test_products_take_the_latest_factor_last():
     """arrange_by_depth: F1' h/2 sign(F0) with F1' ready last is (h/2 sign(F0)) F1', one
     product after F1'; a negative coefficient stays outside; the value is unchanged."""
-    from implc.optimize import arrange_by_depth
-
     a, b, late = sympy.symbols("a b late", real=True)
     sign = sympy.sign(a)
     for expr in (sympy.Rational(1, 2) * b * late * sign, -b * late * sign):
@@ -132,8 +130,6 @@ def test_no_sum_of_three_terms_is_printed_flat(example):
 def test_estrin_evaluates_the_polynomial(degree):
     """The marcher's F', F'' by Estrin's scheme (its powers s^2, s^4, ... as lets) are
     the polynomial: against numpy's Horner on random coefficients."""
-    from implc.marcher import _estrin
-
     rng = np.random.default_rng(degree)
     c = rng.normal(size=degree + 1)
     s = sympy.Symbol("s", real=True)
