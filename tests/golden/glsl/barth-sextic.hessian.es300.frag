@@ -81,7 +81,7 @@ vec3 grad(vec3 p) {
 vec2 ray_DH(Ray ray, float s) {
     float s_2 = s*s;
     float s_4 = s_2*s_2;
-    return vec2((5.0*ray.c5 + 6.0*ray.c6*s)*s_4 + ((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s)), 30.0*ray.c6*s_4 + ((12.0*ray.c4 + 20.0*ray.c5*s)*s_2 + (2.0*ray.c2 + 6.0*ray.c3*s)));
+    return vec2((5.0*ray.c5 + 6.0*ray.c6*s)*s_4 + ((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s)), 6.0*ray.c6*(5.0*s_4) + ((12.0*ray.c4 + 5.0*ray.c5*(4.0*s))*s_2 + (2.0*ray.c2 + 3.0*ray.c3*(2.0*s))));
 }
 
 // dS at march parameter s: Estrin's scheme on the ray polynomial

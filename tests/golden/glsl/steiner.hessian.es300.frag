@@ -72,7 +72,7 @@ vec3 grad(vec3 p) {
 // dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 vec2 ray_DH(Ray ray, float s) {
     float s_2 = s*s;
-    return vec2((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s), 12.0*ray.c4*s_2 + (2.0*ray.c2 + 6.0*ray.c3*s));
+    return vec2((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s), 4.0*ray.c4*(3.0*s_2) + (2.0*ray.c2 + 3.0*ray.c3*(2.0*s)));
 }
 
 // dS at march parameter s: Estrin's scheme on the ray polynomial

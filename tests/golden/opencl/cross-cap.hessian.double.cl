@@ -75,7 +75,7 @@ double3 grad(double3 p) {
 // dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 double2 ray_DH(Ray ray, double s) {
     double s_2 = s*s;
-    return (double2)((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s), 12.0*ray.c4*s_2 + (2.0*ray.c2 + 6.0*ray.c3*s));
+    return (double2)((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s), 4.0*ray.c4*(3.0*s_2) + (2.0*ray.c2 + 3.0*ray.c3*(2.0*s)));
 }
 
 // dS at march parameter s: Estrin's scheme on the ray polynomial

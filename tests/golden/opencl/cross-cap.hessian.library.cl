@@ -75,7 +75,7 @@ float3 cross_cap_grad(float3 p) {
 // dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 float2 cross_cap_ray_DH(cross_cap_Ray ray, float s) {
     float s_2 = s*s;
-    return (float2)((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s), 12.0f*ray.c4*s_2 + (2.0f*ray.c2 + 6.0f*ray.c3*s));
+    return (float2)((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s), 4.0f*ray.c4*(3.0f*s_2) + (2.0f*ray.c2 + 3.0f*ray.c3*(2.0f*s)));
 }
 
 // dS at march parameter s: Estrin's scheme on the ray polynomial

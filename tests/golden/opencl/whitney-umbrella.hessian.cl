@@ -65,7 +65,7 @@ float3 grad(float3 p) {
 // dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 float2 ray_DH(Ray ray, float s) {
     float s_2 = s*s;
-    return (float2)(3.0f*ray.c3*s_2 + (ray.c1 + 2.0f*ray.c2*s), 2.0f*ray.c2 + 6.0f*ray.c3*s);
+    return (float2)(3.0f*ray.c3*s_2 + (ray.c1 + 2.0f*ray.c2*s), 2.0f*ray.c2 + 3.0f*ray.c3*(2.0f*s));
 }
 
 // dS at march parameter s: Estrin's scheme on the ray polynomial

@@ -88,7 +88,7 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
 fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
     let s_2: f32 = s*s;
     let s_4: f32 = s_2*s_2;
-    return vec2<f32>((5.0f*ray.c5 + 6.0f*ray.c6*s)*s_4 + ((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s)), 30.0f*ray.c6*s_4 + ((12.0f*ray.c4 + 20.0f*ray.c5*s)*s_2 + (2.0f*ray.c2 + 6.0f*ray.c3*s)));
+    return vec2<f32>((5.0f*ray.c5 + 6.0f*ray.c6*s)*s_4 + ((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s)), 6.0f*ray.c6*(5.0f*s_4) + ((12.0f*ray.c4 + 5.0f*ray.c5*(4.0f*s))*s_2 + (2.0f*ray.c2 + 3.0f*ray.c3*(2.0f*s))));
 }
 
 // dS at march parameter s: Estrin's scheme on the ray polynomial

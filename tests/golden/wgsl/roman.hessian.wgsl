@@ -81,7 +81,7 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
 // dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
 fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
     let s_2: f32 = s*s;
-    return vec2<f32>((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s), 12.0f*ray.c4*s_2 + (2.0f*ray.c2 + 6.0f*ray.c3*s));
+    return vec2<f32>((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s), 4.0f*ray.c4*(3.0f*s_2) + (2.0f*ray.c2 + 3.0f*ray.c3*(2.0f*s)));
 }
 
 // dS at march parameter s: Estrin's scheme on the ray polynomial
