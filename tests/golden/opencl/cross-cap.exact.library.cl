@@ -139,85 +139,6 @@ cross_cap_Ray cross_cap_ray_of(float3 ro, float3 rd, float sm, float hr) {
     return (cross_cap_Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
 }
 
-// The root of P3 in [a0, b0], where P3 is monotonic and fa0, fb are its values at a0, b0
-// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
-// bracketed by [a, b], a step that leaves it or meets P2 = 0 becomes the midpoint;
-// stops when the step is below CTOL or after NEWTON_STEPS steps; b when P3 does not change sign.
-
-float cross_cap_root3(cross_cap_Ray ray, float a0, float b0, float fa0, float fb) {
-    float a = a0;
-    float b = b0;
-    float fa = fa0;
-    if (fa*fb > 0.0f || !(a < b)) {
-        return b;
-    }
-    if (fa == 0.0f) {
-        return a;
-    }
-    float x = (fb != fa ? a - fa*(b - a)/(fb - fa) : 0.5f*(a + b));
-    for (int i = 0; i < CROSS_CAP_NEWTON_STEPS; ++i) {
-        float f = cross_cap_P3(ray, x);
-        float d = cross_cap_P2(ray, x);
-        if (fa*f <= 0.0f) {
-            b = x;
-        } else {
-            a = x;
-            fa = f;
-        }
-        float next = x - f/d;
-        if (d == 0.0f || !(next >= a && next <= b)) {
-            next = 0.5f*(a + b);
-        }
-        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
-        // a root, kept as it is where d = 0 too)
-        if (fabs(f) <= CROSS_CAP_CTOL*(1.0f + fabs(x))*fabs(d)) {
-            x = (d != 0.0f ? next : x);
-            break;
-        }
-        x = next;
-    }
-    return x;
-}
-
-// The root of P4 in [a0, b0], where P4 is monotonic and fa0, fb are its values at a0, b0
-// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
-// bracketed by [a, b], a step that leaves it or meets P3 = 0 becomes the midpoint;
-// stops when the step is below XTOL or after NEWTON_STEPS steps; b when P4 does not change sign.
-
-float cross_cap_root4(cross_cap_Ray ray, float a0, float b0, float fa0, float fb) {
-    float a = a0;
-    float b = b0;
-    float fa = fa0;
-    float x = (fb != fa ? a - fa*(b - a)/(fb - fa) : 0.5f*(a + b));
-    for (int i = 0; i < CROSS_CAP_NEWTON_STEPS; ++i) {
-        float f = cross_cap_P4(ray, x);
-        float d = cross_cap_P3(ray, x);
-        if (fa*f <= 0.0f) {
-            b = x;
-        } else {
-            a = x;
-            fa = f;
-        }
-        // Halley's step where its correction is moderate (|f F''| < F'^2; F'' = P2 is at
-        // hand): x - f F'/(F'^2 - f F''/2), cubic convergence; else Newton's, x - f F'/F'^2.
-        // One division either way (it is the slow operation of the loop).
-        float dd = d*d;
-        float fh = f*cross_cap_P2(ray, x);
-        float next = x - f*d/(dd - (fabs(fh) < dd ? 0.5f*fh : 0.0f));
-        if (d == 0.0f || !(next >= a && next <= b)) {
-            next = 0.5f*(a + b);
-        }
-        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
-        // a root, kept as it is where d = 0 too)
-        if (fabs(f) <= CROSS_CAP_XTOL*(1.0f + fabs(x))*fabs(d)) {
-            x = (d != 0.0f ? next : x);
-            break;
-        }
-        x = next;
-    }
-    return x;
-}
-
 // Exact root isolation (the `exact` method) on [t0, t1] of the ray ro + t rd (|rd| = 1):
 // the first root of F(s) = S(ro + s rd), a sign change or a touching root (|F| within
 // TOUCH of the size of F's terms at a critical point). No marching: `steps` is 0.
@@ -355,25 +276,84 @@ cross_cap_Hit cross_cap_trace(float3 ro, float3 rd, float t0, float t1) {
                 f = fq;
                 d = dq;
             }
-            if (!pending) {
+            // One Newton loop for every lane with something to solve, whichever it is: the
+            // root of F = P4 in its bracket [a, b] (mode 1), or the extremum of the piece
+            // that stopped the walk, the root of F' = P3 in [gp, gq] (mode 2), after
+            // which F at it decides (mode 3): a touching root, a sign change before it (mode
+            // 1 on [gp, m]), or neither (the walk goes on after it). One loop, not one per
+            // kind: a loop runs at least once for a SIMD group, even one with no lane in it
+            // (measured: the extremum's own loop cost 10-20 % of the frame on the quartics).
+            int mode = (bracket ? 1 : (pending ? 2 : 0));
+            if (pending) {
+                a = gp;
+                b = gq;
+                fa = gd;
+                fb = gdq;
+            }
+            float x = (fb != fa ? a - fa*(b - a)/(fb - fa) : 0.5f*(a + b));
+            if (pending && (fa == 0.0f || !(a < b))) {
+                x = (fa == 0.0f ? a : b);
+                mode = 3;
+            }
+            bool again = false;
+            int tries = 0;
+            for (int i = 0; i < 2*CROSS_CAP_NEWTON_STEPS + 1; ++i) {
+                if (mode == 0) {
+                    break;
+                }
+                float f_x = cross_cap_P4(ray, x);
+                float d_x = cross_cap_P3(ray, x);
+                float dd_x = cross_cap_P2(ray, x);
+                if (mode == 3) {
+                    if (fabs(f_x) <= CROSS_CAP_TOUCH*cross_cap_scale_at(ray, x)) {
+                        found = true;
+                        u = x;
+                        mode = 0;
+                    } else if (gf*f_x <= 0.0f) {
+                        found = true;
+                        mode = 1;
+                        tries = 0;
+                        a = gp;
+                        b = x;
+                        fa = gf;
+                        x = (f_x != gf ? gp - gf*(x - gp)/(f_x - gf) : 0.5f*(gp + x));
+                    } else {
+                        again = true;
+                        mode = 0;
+                    }
+                } else {
+                    bool root = mode == 1;
+                    float g = (root ? f_x : d_x);
+                    float dg = (root ? d_x : dd_x);
+                    if (fa*g <= 0.0f) {
+                        b = x;
+                    } else {
+                        a = x;
+                        fa = g;
+                    }
+                    // for F, Halley's step where its correction is moderate (|f F''| < F'^2):
+                    // x - f F'/(F'^2 - f F''/2), cubic convergence; else (and for F') Newton's,
+                    // x - g g'/g'^2. One division either way (the slow operation of the loop).
+                    float gg = dg*dg;
+                    float gh = (root ? g*dd_x : 0.0f);
+                    float next = x - g*dg/(gg - (fabs(gh) < gg ? 0.5f*gh : 0.0f));
+                    if (dg == 0.0f || !(next >= a && next <= b)) {
+                        next = 0.5f*(a + b);
+                    }
+                    tries += 1;
+                    // converged when the Newton step |g/g'| is below the tolerance (g = 0
+                    // included: x is a root, kept as it is where g' = 0 too), or out of steps
+                    bool converged = fabs(g) <= (root ? CROSS_CAP_XTOL : CROSS_CAP_CTOL)*(1.0f + fabs(x))*fabs(dg);
+                    x = (converged && dg == 0.0f ? x : next);
+                    if (converged || tries >= CROSS_CAP_NEWTON_STEPS) {
+                        u = (root ? x : u);
+                        mode = (root ? 0 : 3);
+                    }
+                }
+            }
+            if (!again) {
                 break;
             }
-            float m = cross_cap_root3(ray, gp, gq, gd, gdq);
-            float fm = cross_cap_P4(ray, m);
-            if (fabs(fm) <= CROSS_CAP_TOUCH*cross_cap_scale_at(ray, m)) {
-                found = true;
-                u = m;
-            } else if (gf*fm <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = gp;
-                b = m;
-                fa = gf;
-                fb = fm;
-            }
-        }
-        if (bracket) {
-            u = cross_cap_root4(ray, a, b, fa, fb);
         }
     }
     return (cross_cap_Hit){found, (found ? u + ray.sm : t1), 0};

@@ -147,85 +147,6 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
 }
 
-// The root of P3 in [a0, b0], where P3 is monotonic and fa0, fb are its values at a0, b0
-// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
-// bracketed by [a, b], a step that leaves it or meets P2 = 0 becomes the midpoint;
-// stops when the step is below CTOL or after NEWTON_STEPS steps; b when P3 does not change sign.
-
-fn root3(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
-    var a: f32 = a0;
-    var b: f32 = b0;
-    var fa: f32 = fa0;
-    if (fa*fb > 0.0f || !(a < b)) {
-        return b;
-    }
-    if (fa == 0.0f) {
-        return a;
-    }
-    var x: f32 = select(0.5f*(a + b), a - fa*(b - a)/(fb - fa), fb != fa);
-    for (var i: i32 = 0; i < NEWTON_STEPS; i++) {
-        let f: f32 = P3(ray, x);
-        let d: f32 = P2(ray, x);
-        if (fa*f <= 0.0f) {
-            b = x;
-        } else {
-            a = x;
-            fa = f;
-        }
-        var next: f32 = x - f/d;
-        if (d == 0.0f || !(next >= a && next <= b)) {
-            next = 0.5f*(a + b);
-        }
-        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
-        // a root, kept as it is where d = 0 too)
-        if (abs(f) <= CTOL*(1.0f + abs(x))*abs(d)) {
-            x = select(x, next, d != 0.0f);
-            break;
-        }
-        x = next;
-    }
-    return x;
-}
-
-// The root of P4 in [a0, b0], where P4 is monotonic and fa0, fb are its values at a0, b0
-// (known to the caller: an end is shared by two pieces, so it is evaluated once). Newton
-// bracketed by [a, b], a step that leaves it or meets P3 = 0 becomes the midpoint;
-// stops when the step is below XTOL or after NEWTON_STEPS steps; b when P4 does not change sign.
-
-fn root4(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
-    var a: f32 = a0;
-    var b: f32 = b0;
-    var fa: f32 = fa0;
-    var x: f32 = select(0.5f*(a + b), a - fa*(b - a)/(fb - fa), fb != fa);
-    for (var i: i32 = 0; i < NEWTON_STEPS; i++) {
-        let f: f32 = P4(ray, x);
-        let d: f32 = P3(ray, x);
-        if (fa*f <= 0.0f) {
-            b = x;
-        } else {
-            a = x;
-            fa = f;
-        }
-        // Halley's step where its correction is moderate (|f F''| < F'^2; F'' = P2 is at
-        // hand): x - f F'/(F'^2 - f F''/2), cubic convergence; else Newton's, x - f F'/F'^2.
-        // One division either way (it is the slow operation of the loop).
-        let dd: f32 = d*d;
-        let fh: f32 = f*P2(ray, x);
-        var next: f32 = x - f*d/(dd - select(0.0f, 0.5f*fh, abs(fh) < dd));
-        if (d == 0.0f || !(next >= a && next <= b)) {
-            next = 0.5f*(a + b);
-        }
-        // converged when the Newton step |f/d| is below the tolerance (f = 0 included: x is
-        // a root, kept as it is where d = 0 too)
-        if (abs(f) <= XTOL*(1.0f + abs(x))*abs(d)) {
-            x = select(x, next, d != 0.0f);
-            break;
-        }
-        x = next;
-    }
-    return x;
-}
-
 // Exact root isolation (the `exact` method) on [t0, t1] of the ray ro + t rd (|rd| = 1):
 // the first root of F(s) = S(ro + s rd), a sign change or a touching root (|F| within
 // TOUCH of the size of F's terms at a critical point). No marching: `steps` is 0.
@@ -363,25 +284,84 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 f = fq;
                 d = dq;
             }
-            if (!pending) {
+            // One Newton loop for every lane with something to solve, whichever it is: the
+            // root of F = P4 in its bracket [a, b] (mode 1), or the extremum of the piece
+            // that stopped the walk, the root of F' = P3 in [gp, gq] (mode 2), after
+            // which F at it decides (mode 3): a touching root, a sign change before it (mode
+            // 1 on [gp, m]), or neither (the walk goes on after it). One loop, not one per
+            // kind: a loop runs at least once for a SIMD group, even one with no lane in it
+            // (measured: the extremum's own loop cost 10-20 % of the frame on the quartics).
+            var mode: i32 = select(select(0, 2, pending), 1, bracket);
+            if (pending) {
+                a = gp;
+                b = gq;
+                fa = gd;
+                fb = gdq;
+            }
+            var x: f32 = select(0.5f*(a + b), a - fa*(b - a)/(fb - fa), fb != fa);
+            if (pending && (fa == 0.0f || !(a < b))) {
+                x = select(b, a, fa == 0.0f);
+                mode = 3;
+            }
+            var again: bool = false;
+            var tries: i32 = 0;
+            for (var i: i32 = 0; i < 2*NEWTON_STEPS + 1; i++) {
+                if (mode == 0) {
+                    break;
+                }
+                let f_x: f32 = P4(ray, x);
+                let d_x: f32 = P3(ray, x);
+                let dd_x: f32 = P2(ray, x);
+                if (mode == 3) {
+                    if (abs(f_x) <= TOUCH*scale_at(ray, x)) {
+                        found = true;
+                        u = x;
+                        mode = 0;
+                    } else if (gf*f_x <= 0.0f) {
+                        found = true;
+                        mode = 1;
+                        tries = 0;
+                        a = gp;
+                        b = x;
+                        fa = gf;
+                        x = select(0.5f*(gp + x), gp - gf*(x - gp)/(f_x - gf), f_x != gf);
+                    } else {
+                        again = true;
+                        mode = 0;
+                    }
+                } else {
+                    let root: bool = mode == 1;
+                    let g: f32 = select(d_x, f_x, root);
+                    let dg: f32 = select(dd_x, d_x, root);
+                    if (fa*g <= 0.0f) {
+                        b = x;
+                    } else {
+                        a = x;
+                        fa = g;
+                    }
+                    // for F, Halley's step where its correction is moderate (|f F''| < F'^2):
+                    // x - f F'/(F'^2 - f F''/2), cubic convergence; else (and for F') Newton's,
+                    // x - g g'/g'^2. One division either way (the slow operation of the loop).
+                    let gg: f32 = dg*dg;
+                    let gh: f32 = select(0.0f, g*dd_x, root);
+                    var next: f32 = x - g*dg/(gg - select(0.0f, 0.5f*gh, abs(gh) < gg));
+                    if (dg == 0.0f || !(next >= a && next <= b)) {
+                        next = 0.5f*(a + b);
+                    }
+                    tries += 1;
+                    // converged when the Newton step |g/g'| is below the tolerance (g = 0
+                    // included: x is a root, kept as it is where g' = 0 too), or out of steps
+                    let converged: bool = abs(g) <= select(CTOL, XTOL, root)*(1.0f + abs(x))*abs(dg);
+                    x = select(next, x, converged && dg == 0.0f);
+                    if (converged || tries >= NEWTON_STEPS) {
+                        u = select(u, x, root);
+                        mode = select(3, 0, root);
+                    }
+                }
+            }
+            if (!again) {
                 break;
             }
-            let m: f32 = root3(ray, gp, gq, gd, gdq);
-            let fm: f32 = P4(ray, m);
-            if (abs(fm) <= TOUCH*scale_at(ray, m)) {
-                found = true;
-                u = m;
-            } else if (gf*fm <= 0.0f) {
-                found = true;
-                bracket = true;
-                a = gp;
-                b = m;
-                fa = gf;
-                fb = fm;
-            }
-        }
-        if (bracket) {
-            u = root4(ray, a, b, fa, fb);
         }
     }
     return Hit(found, select(t1, u + ray.sm, found), 0);
