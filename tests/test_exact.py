@@ -116,6 +116,28 @@ def test_roman_double_lines_are_touched():
     np.testing.assert_allclose(got[:, 1], [1.0, 1.0, 1.0], atol=1e-3)
 
 
+def test_walk_resumes_after_a_grazing_piece():
+    """Rays in the plane y = 0 that pass just above the torus's left tube (F dips towards
+    zero without reaching it: the walk stops there, the extremum decides "no root") and
+    then cross the right tube: the walk goes on after the extremum and finds that root. In
+    that plane the tube is (x - 1)^2 + z^2 = r^2 (x > 0), r^2 = 49/400; along the ray
+    z = z0 - k (x + 1)."""
+    require_gl()
+    rays, expected = [], []
+    for z0, k in ((0.36, 0.01), (0.355, 0.01), (0.352, 0.005)):
+        x0 = -2.0
+        rd = np.array([1.0, 0.0, -k]) / np.hypot(1.0, k)
+        rays.append(((x0, 0.0, z0 + k), tuple(rd), 0.0, 4.5))
+        # (x - 1)^2 + (z0 - k (x + 1))^2 - r^2 = 0: the smaller root is the first crossing
+        a, b = 1 + k * k, -2 - 2 * k * (z0 - k)
+        c = 1 + (z0 - k) ** 2 - 49 / 400
+        x = (-b - np.sqrt(b * b - 4 * a * c)) / (2 * a)
+        expected.append((x - x0) / rd[0])
+    got = _rays("torus", rays)
+    assert np.all(got[:, 0] == 1), got
+    np.testing.assert_allclose(got[:, 1], expected, atol=1e-4)
+
+
 @pytest.mark.parametrize("example", ["gyroid", "blobs"])
 def test_exact_refuses_non_polynomials(example):
     with pytest.raises(InputError, match="needs a polynomial surface.*use one of"):
