@@ -321,17 +321,18 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
                     bool root = mode == 1;
                     float g = (root ? f_x : d_x);
                     float dg = (root ? d_x : dd_x);
+                    // g'' = F'' for F (Halley's step), 0 for F' (Newton's)
                     if (fa*g <= 0.0) {
                         b = x;
                     } else {
                         a = x;
                         fa = g;
                     }
-                    // for F, Halley's step where its correction is moderate (|f F''| < F'^2):
-                    // x - f F'/(F'^2 - f F''/2), cubic convergence; else (and for F') Newton's,
-                    // x - g g'/g'^2. One division either way (the slow operation of the loop).
+                    // Halley's step where its correction is moderate (|g g''| < dg^2):
+                    // x - g dg/(dg^2 - g g''/2), cubic convergence; else Newton's.
+                    // One division either way (the slow operation of the loop).
                     float gg = dg*dg;
-                    float gh = (root ? g*dd_x : 0.0);
+                    float gh = g*(root ? dd_x : 0.0);
                     float next = x - g*dg/(gg - (abs(gh) < gg ? 0.5*gh : 0.0));
                     if (dg == 0.0 || !(next >= a && next <= b)) {
                         next = 0.5*(a + b);

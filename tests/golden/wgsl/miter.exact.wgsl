@@ -335,17 +335,18 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                     let root: bool = mode == 1;
                     let g: f32 = select(d_x, f_x, root);
                     let dg: f32 = select(dd_x, d_x, root);
+                    // g'' = F'' for F (Halley's step), 0 for F' (Newton's)
                     if (fa*g <= 0.0f) {
                         b = x;
                     } else {
                         a = x;
                         fa = g;
                     }
-                    // for F, Halley's step where its correction is moderate (|f F''| < F'^2):
-                    // x - f F'/(F'^2 - f F''/2), cubic convergence; else (and for F') Newton's,
-                    // x - g g'/g'^2. One division either way (the slow operation of the loop).
+                    // Halley's step where its correction is moderate (|g g''| < dg^2):
+                    // x - g dg/(dg^2 - g g''/2), cubic convergence; else Newton's.
+                    // One division either way (the slow operation of the loop).
                     let gg: f32 = dg*dg;
-                    let gh: f32 = select(0.0f, g*dd_x, root);
+                    let gh: f32 = g*select(0.0f, dd_x, root);
                     var next: f32 = x - g*dg/(gg - select(0.0f, 0.5f*gh, abs(gh) < gg));
                     if (dg == 0.0f || !(next >= a && next <= b)) {
                         next = 0.5f*(a + b);
