@@ -116,7 +116,8 @@ def check_exact(expr: sympy.Expr) -> int:
 
 def default_method(expr: sympy.Expr) -> str:
     """The method `-m` defaults to: `exact` where it applies (polynomials up to
-    EXACT_MAX_DEGREE; measured the most accurate and the fastest), else `hessian`."""
+    EXACT_MAX_DEGREE; measured the most accurate there, and the fastest up to degree 6),
+    else `hessian`."""
     degree = polynomial_degree(expr)
     return "exact" if degree is not None and degree <= EXACT_MAX_DEGREE else "hessian"
 
@@ -286,12 +287,13 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     programs = build_programs(expr, point_sets(method, form), max_derived)
     functions = [_point_function(name, program, printer, carried)
                  for name, program in programs.items()]
-    ray_fields, ray = _carry(carried, (), Code((), ()))
+    fields, ray = (), Code((), ())  # the point form's ray record: o, d and sm only
     if form == "ray-poly":
         coefficients = coefficient_program(expr)
         n = len(coefficients.outputs) - 1
-        ray_fields, ray = _carry(carried, *_ray_setup(coefficients, printer))
+        fields, ray = _ray_setup(coefficients, printer)
         functions += [_estrin_function(q, n, printer) for kind, q in wanted if kind == "ray"]
+    ray_fields, ray = _carry(carried, fields, ray)
     by_name = {f.name: f for f in functions}
 
     def call(kind: str, quantities: tuple[str, ...], arg: sympy.Expr,
