@@ -519,12 +519,13 @@ def _estrin_derivative(n: int, m: int, x: sympy.Symbol):
 
 
 def _weighted_coefficients(n: int, m: int) -> tuple[list[sympy.Expr], list[int]]:
-    """F^(m)'s coefficients (m >= 1) over F''s, k c_k, and the integer weights
-    (k-1)!/(k-m)! that make them k!/(k-m)! c_k: F'' over the loop invariants F' holds
-    already, with its factors on the powers of s. Measured on the quartic paper surfaces
-    (hessian, 1024^2): the march step as fast as taylor's, where F'' over its own
-    invariants 2c2, 6c3, 12c4 cost 1.2-1.5 % a frame on the Steiner surface (two more
-    values kept in registers for the whole loop)."""
+    """F^(m)'s coefficients (m >= 1) written over those of F', k c_k, with the integer
+    weights (k-1)!/(k-m)! that make them k!/(k-m)! c_k (_estrin puts each weight on the
+    power of s its term meets). So F'' in a march loop reads only the loop invariants F'
+    holds already (up to degree 4): measured on the quartic paper surfaces (hessian,
+    1024^2), the march step as fast as taylor's, where F'' over its own coefficients (6c3
+    and 12c4, two more values live for the whole loop) cost 1.2-1.5 % a frame on the
+    Steiner surface."""
     ks = range(m, n + 1)
     return [sympy.Mul(k, _sym(f"ray.c{k}")) for k in ks], [int(sympy.ff(k - 1, m - 1)) for k in ks]
 

@@ -282,7 +282,7 @@ cross_cap_Hit cross_cap_trace(float3 ro, float3 rd, float t0, float t1) {
             // which F at it decides (mode 3): a touching root, a sign change before it (mode
             // 1 on [gp, m]), or neither (the walk goes on after it). One loop, not one per
             // kind: a loop runs at least once for a SIMD group, even one with no lane in it
-            // (measured: the extremum's own loop cost 10-20 % of the frame on the quartics).
+            // (measured: the extremum's own loop cost 18-26 % of the frame on the quartics).
             int mode = (bracket ? 1 : (pending ? 2 : 0));
             if (pending) {
                 a = gp;

@@ -288,7 +288,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             // which F at it decides (mode 3): a touching root, a sign change before it (mode
             // 1 on [gp, m]), or neither (the walk goes on after it). One loop, not one per
             // kind: a loop runs at least once for a SIMD group, even one with no lane in it
-            // (measured: the extremum's own loop cost 10-20 % of the frame on the quartics).
+            // (measured: the extremum's own loop cost 18-26 % of the frame on the quartics).
             var mode: i32 = select(select(0, 2, pending), 1, bracket);
             if (pending) {
                 a = gp;
