@@ -99,6 +99,7 @@ def test_sums_add_the_latest_term_last():
         text = emit(load_surface("cross-cap"), target, "taylor", METHODS["taylor"].defaults)
         assert "*(t0 + (x_2 + z))" in text, target
 
+
 def test_products_take_the_latest_factor_last():
     """arrange_by_depth: F1' h/2 sign(F0) with F1' ready last is (h/2 sign(F0)) F1', one
     product after F1'; a negative coefficient stays outside; the value is unchanged."""
@@ -159,8 +160,8 @@ def test_second_derivative_reads_the_first_derivatives_invariants(degree):
     (measured 1.2-1.5 % a frame on the Steiner surface, marcher._weighted_coefficients),
     above it fewer than F'' over its own coefficients k(k-1) c_k; and it is F''."""
     s = sympy.Symbol("s", real=True)
-    d1, p1 = _estrin(*_weighted(degree, 1, s))
-    d2, p2 = _estrin(*_weighted(degree, 2, s))
+    d1, p1 = _weighted_estrin(degree, 1, s)
+    d2, p2 = _weighted_estrin(degree, 2, s)
     own, p3 = _estrin_derivative(degree, 2, s)
     varying = {s, *(k for k, _ in p1 + p2 + p3)}
     first = _invariants(d1, varying)
@@ -176,6 +177,7 @@ def test_second_derivative_reads_the_first_derivatives_invariants(degree):
     assert sympy.expand(d2 - d2f) == 0
 
 
-def _weighted(n: int, m: int, s: sympy.Symbol):
+def _weighted_estrin(n: int, m: int, s: sympy.Symbol):
+    """F^(m) at s as the march evaluates it (marcher._estrin_function)."""
     coefficients, weights = _weighted_coefficients(n, m)
-    return coefficients, s, weights
+    return _estrin(coefficients, s, weights)
