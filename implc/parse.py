@@ -66,7 +66,7 @@ from implc.errors import InputError, LimitError, Source
 from implc.functions import CONSTANTS, USER_FUNCTIONS
 from implc.symbols import X, Y, Z
 
-__all__ = ["Limits", "check_param_name", "param_symbol", "parse_equation",
+__all__ = ["Limits", "check_param_name", "fold_constants", "param_symbol", "parse_equation",
            "parse_equation_with_params", "parse_number"]
 
 
@@ -250,9 +250,10 @@ def _parse(
         info = _Analyzer(source, values, limits).analyze(root)
         builder = _Builder(source, values, info, limits)
         expr = builder.build(root)
+        folded = fold_constants(expr)
         if not keep_params:
-            return expr, None
-        return expr, _build_symbolic(root, builder.built, info)
+            return folded, None
+        return folded, fold_constants(_build_symbolic(root, builder.built, info))
     except RecursionError:
         raise LimitError(
             f"too complex: nesting is too deep to parse with the limit of {limits.max_depth} "
@@ -335,6 +336,54 @@ def check_param_name(name: str, source: Source | None = None) -> None:
         raise InputError(
             f"parameter name '{name}' shadows the constant {constant}", source, 0, length
         )
+
+
+# Digits a folded constant keeps (`fold_constants`): far past float64's 17, so the float
+# literal printed from it is the correctly rounded value of the constant as written.
+FOLD_DIGITS = 30
+
+
+def fold_constants(expr: sympy.Expr) -> sympy.Expr:
+    """`expr` with every maximal sub-expression free of symbols made a number: rationals
+    stay exact, anything else (`pi`, `sqrt(2)`, `cos(314159265358979/400000000000000)`)
+    becomes a `FOLD_DIGITS`-digit Float, evaluated once.
+
+    Why: sympy keeps such constants as expressions, and every polynomial operation then
+    runs over its expression domain (`Poly` of the Endrass octic with `cos(pi/4)` written
+    as SURFER writes pi took 66 s; over the reals it takes milliseconds). A parameter kept
+    as a symbol (`--params uniform`) is not folded, nor anything holding it. Runs after
+    every check of the builder (they need the exact forms); the value printed in a shader
+    is the same float64 literal as before, since printers print each constant's value.
+    Iterative, so a deep tree (up to --max-depth) cannot exhaust Python's stack."""
+    folded: dict[sympy.Basic, sympy.Basic] = {}
+    stack: list[tuple[sympy.Basic, bool]] = [(expr, False)]
+    while stack:
+        node, ready = stack.pop()
+        if node in folded:
+            continue
+        if not node.free_symbols:
+            folded[node] = node if node.is_Rational else _number(node)
+            continue
+        if not ready and node.args:
+            stack.append((node, True))
+            stack.extend((a, False) for a in node.args if a not in folded)
+            continue
+        args = tuple(folded.get(a, a) for a in node.args)
+        if args == node.args:
+            folded[node] = node
+        elif type(node).__name__ in _UNEVALUATED:
+            folded[node] = node.func(*args, evaluate=False)
+        else:
+            folded[node] = node.func(*args)
+    return folded[expr]
+
+
+def _number(constant: sympy.Expr) -> sympy.Expr:
+    """A constant the builder checked (finite and real) as a FOLD_DIGITS-digit Float."""
+    value = constant.evalf(FOLD_DIGITS)
+    if value.is_Rational:
+        return value
+    return sympy.Float(value, FOLD_DIGITS)
 
 
 def _build_symbolic(

@@ -22,6 +22,11 @@ class _EquationPrinter(StrPrinter):
             return repr(float(expr))
         return super()._print_Rational(expr)
 
+    def _print_Float(self, expr):
+        """A folded constant (parse.fold_constants) as the shortest decimal of its float64
+        value, the value a shader gets: `sqrt(2)` reads 1.4142135623730951."""
+        return repr(float(expr))
+
     def _print_Mul(self, expr):
         coeff, rest = expr.as_coeff_Mul()
         if coeff.is_Rational and coeff.q > 1000 and rest != 1:

@@ -181,3 +181,37 @@ def _weighted_estrin(n: int, m: int, s: sympy.Symbol):
     """F^(m) at s as the march evaluates it (marcher._estrin_function)."""
     coefficients, weights = _weighted_coefficients(n, m)
     return _estrin(coefficients, s, weights)
+
+
+def test_degree_is_computed_once_per_compile():
+    """`polynomial_degree` expands S (the costliest question a compile asks of it): the
+    default method, the evaluation form, exact's check and the ray coefficients all ask
+    it, and one compile computes it once."""
+    from implc.derive import polynomial_degree
+    from implc.marcher import default_method
+
+    surface = load_surface(equation="x^4 + y^4 + z^4 - 1 + x y z/7")  # fresh: not cached
+    before = polynomial_degree.cache_info()
+    emit(surface, "glsl", default_method(surface.expr))
+    after = polynomial_degree.cache_info()
+    assert after.misses - before.misses == 1 and after.hits > before.hits
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_expanded_polynomials_differentiate_as_sympy_does(seed):
+    """branch_diff's Poly path for an expanded rational polynomial gives sympy.diff's own
+    expression (the same tree, so the same shader), only faster."""
+    from implc.derive import _is_expanded_rational_polynomial, branch_diff
+
+    rng = np.random.default_rng(seed)
+    x, y, z = POINT
+    terms = [sympy.Rational(int(rng.integers(-40, 40)), int(rng.integers(1, 9)))
+             * x ** int(rng.integers(0, 7)) * y ** int(rng.integers(0, 7))
+             * z ** int(rng.integers(0, 7)) for _ in range(30)]
+    expr = sympy.Add(*terms)
+    assert _is_expanded_rational_polynomial(expr)
+    for v in POINT:
+        assert branch_diff(expr, v) == sympy.diff(expr, v)
+        assert branch_diff(branch_diff(expr, v), x) == sympy.diff(sympy.diff(expr, v), x)
+    for other in ((x + 1) ** 2 * y, sympy.sqrt(2) * x**2, x**2 * sympy.sin(y), x ** -1):
+        assert not _is_expanded_rational_polynomial(other)
