@@ -16,7 +16,8 @@ NPM_DIR := tests/browser
 NPM_STAMP := $(NPM_DIR)/node_modules/.implc-installed
 VIEW_SURFACE := torus
 
-.PHONY: setup demo view test golden lint bench bench-baseline forms clean system-packages fuzz corpus
+.PHONY: setup demo view test golden lint bench bench-baseline forms clean system-packages fuzz corpus \
+  compile-times
 
 setup: system-packages $(STAMP) $(NPM_STAMP)
 
@@ -106,6 +107,12 @@ fuzz: setup
 # The corpus report (docs/CORPUS.md) from ../shared/corpus/ (40-70 s with 2 workers).
 corpus: setup
 	$(PY) -m implc corpus -j 2 -o docs/CORPUS.md
+
+# Compile time of every corpus row as a user meets it (`implc compile -e ROW`, default
+# method, GLSL, a fresh process each, two at a time): the distribution and the slowest
+# ten (docs/RESULTS.md section 6). About 2 minutes on 2 cores.
+compile-times: setup
+	$(PY) scripts/compile_times.py -j 2
 
 clean:
 	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules
