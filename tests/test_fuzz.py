@@ -60,9 +60,11 @@ PARAMS = {"a": sympy.Rational(3, 4), "b": sympy.Rational(-5, 2), "phi": sympy.Ra
     1618033988749895, 10**15), "R": sympy.Integer(2)}
 # Hang guards, CPU seconds per case (tests/cpu_bound.py). Measured on the make-test pass
 # (3,782 cases in 22 s; the summary line prints the costliest of each kind): a parser
-# case takes 0.02 s at most, a whole-path case 0.07 s typically and 0.67 s at most, so
-# each bound is 40x or more of the costliest case and a busy machine cannot trip it; a
-# real hang (the Endrass octic's mutation, 81 s before parse.fold_constants) still fails.
+# case takes 0.02 s at most, a whole-path case 0.07 s typically and 0.67 s at most (at
+# IMPLC_FUZZ_SCALE=20, 34,976 cases: 0.46 s and 0.72 s at most, the parse one re-reading
+# a long printed equation), so each bound is 10x or more of the costliest case and 70x or
+# more of the typical one, and a busy machine cannot trip it; a real hang (the Endrass
+# octic's mutation, 81 s before parse.fold_constants) still fails.
 PARSE_SECONDS = 5.0  # per parser case
 PATH_SECONDS = 30.0  # per whole-path case (derive + CSE + print)
 PATH_MAX_DERIVED = 60_000  # the bound on work that keeps a whole-path case small
