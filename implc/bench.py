@@ -114,7 +114,8 @@ class Cell:
 
     fps: float
     frame_seconds: list[float]
-    setup_seconds: float
+    setup_seconds: float  # implc's emit and the driver's program build
+    compile_seconds: float  # the program's first use, where llvmpipe compiles it
     metrics: dict
     render: str  # PNG path relative to the output directory
     ratio_to_taylor: float | None = None
@@ -125,6 +126,7 @@ class Cell:
             "ratio_to_taylor": self.ratio_to_taylor,
             "frame_seconds": self.frame_seconds,
             "setup_seconds": self.setup_seconds,
+            "compile_seconds": self.compile_seconds,
             **self.metrics,
             "render": self.render,
         }
@@ -223,20 +225,24 @@ def _cpu_model() -> str:
     return platform.processor() or "unknown"
 
 
-def time_interleaved(runners: Sequence, frames: int) -> tuple[list[list[float]], list]:
-    """Seconds of each runner's `frames` frames after one untimed warm-up each, and each
-    runner's last frame, read back after the timing.
+def time_interleaved(runners: Sequence, frames: int) -> tuple[list[list[float]], list,
+                                                               list[float]]:
+    """Seconds of each runner's `frames` frames after its warm-up, each runner's last
+    frame, read back after the timing, and each runner's warm-up seconds (its first use,
+    where the driver compiles: `TimedRunner.warm_up`).
 
     A timed frame is `draw()`: render and wait for completion (glFinish, queue wait). The
     read-back of two float32 RGBA targets (32 MB at 1024^2, ~10 ms on llvmpipe) is the
     same for every method and no part of what an application pays per frame, so timing
     it would pull every ratio towards 1.
 
-    The warm-up absorbs first-use costs (driver shader compilation, allocation). Frames
-    are taken in rounds (one frame of every runner per round), so a burst of load from
-    another process on a shared machine hits every method alike instead of one of them,
-    which keeps the fps ratios fair.
+    The warm-up absorbs first-use costs (driver shader compilation, allocation); one
+    whole frame follows it untimed, so every timed frame starts from the same state.
+    Frames are taken in rounds (one frame of every runner per round), so a burst of load
+    from another process on a shared machine hits every method alike instead of one of
+    them, which keeps the fps ratios fair.
     """
+    compile_seconds = [runner.warm_up() for runner in runners]
     for runner in runners:
         runner.frame()
     seconds: list[list[float]] = [[] for _ in runners]
@@ -246,7 +252,7 @@ def time_interleaved(runners: Sequence, frames: int) -> tuple[list[list[float]],
             runner.draw()
             seconds[index].append(time.perf_counter() - start)
     last = [runner.read() for runner in runners]
-    return seconds, last
+    return seconds, last, compile_seconds
 
 
 def run_bench(
@@ -339,7 +345,7 @@ def _measure_surface(run, config, chosen, key, surface, reference, renders, exr,
         for method in hand:
             runners.append(open_baseline_runner(key, method, constants[chosen.index(method)],
                                                 surface, size, size))
-        seconds, results = time_interleaved(runners, run.frames)
+        seconds, results, compiled = time_interleaved(runners, run.frames)
     finally:
         for runner in runners:
             runner.release()
@@ -352,7 +358,7 @@ def _measure_surface(run, config, chosen, key, surface, reference, renders, exr,
         if exr:
             write_render(result, renders / f"{stem}.exr", meta)
         run.cells[config.name, key, method] = Cell(
-            fps, seconds[index], setup[index], compare(result, reference),
+            fps, seconds[index], setup[index], compiled[index], compare(result, reference),
             f"renders/{stem}.png")
         run.tiles[config.name, key, method] = tile_image(result.color, TILE)
         bar.step(f"{key} {method} {config.name}: {fps:.3g} fps")
@@ -360,7 +366,7 @@ def _measure_surface(run, config, chosen, key, surface, reference, renders, exr,
         index = len(chosen) + offset
         fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
         run.baseline_cells[config.name, key, method] = Cell(
-            fps, seconds[index], 0.0, compare(results[index], reference), "")
+            fps, seconds[index], 0.0, compiled[index], compare(results[index], reference), "")
         bar.note(f"{key} {method} {config.name}, hand-written baseline: {fps:.3g} fps")
 
 

@@ -551,13 +551,15 @@ def cmd_render(args) -> int:
     _resolve_method(args, surface)
     _check_frame(surface, width, height)
     start = time.perf_counter()
-    paths = render_surface(surface, backend, args.method, _constants(args), width, height,
-                           args.output, params=args.params)
+    paths, timing = render_surface(surface, backend, args.method, _constants(args), width,
+                                   height, args.output, params=args.params)
     elapsed = time.perf_counter() - start
     for path in paths:
         print(f"wrote {path}")
     what = backend if backend == "reference" else f"{backend}/{args.method}"
-    print(f"rendered {width}x{height} with {what} in {elapsed:.2f} s",
+    phases = ", ".join(f"{name} {timing[name]:.3f} s" for name in ("setup", "compile", "frame")
+                       if name in timing)
+    print(f"rendered {width}x{height} with {what} in {elapsed:.2f} s ({phases})",
           file=sys.stderr)
     return EXIT_OK
 

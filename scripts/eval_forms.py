@@ -55,7 +55,7 @@ def measure(surface, methods: list[str], size: int, frames: int, exact: bool = F
             runners.append(open_runner(surface, "gl", "exact", get_method("exact").defaults,
                                        size, size))
             keys.append(("exact", "ray-poly"))
-        seconds, last = time_interleaved(runners, frames)
+        seconds, last, _ = time_interleaved(runners, frames)
     finally:
         for r in runners:
             r.release()

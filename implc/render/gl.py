@@ -85,6 +85,15 @@ class GlRunner(TimedRunner):
         self.vao.render(mode=TRIANGLES, vertices=3)
         context().finish()
 
+    def first_use(self) -> None:
+        """One pixel drawn and waited for: llvmpipe compiles the fragment shader at its
+        first draw whatever the viewport (measured: the full frame after it takes what
+        every later frame takes); `draw` sets the whole viewport again."""
+        self.fbo.use()
+        self.fbo.viewport = (0, 0, 1, 1)
+        self.vao.render(mode=TRIANGLES, vertices=3)
+        context().finish()
+
     def read(self) -> RenderResult:
         shape = (self.height, self.width, 4)
         color = np.frombuffer(self.fbo.read(components=4, attachment=0, dtype="f4"), np.float32)

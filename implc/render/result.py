@@ -45,13 +45,32 @@ class RenderResult:
 
 
 class TimedRunner:
-    """Base of the GPU runners: `frame()` = draw, wait for completion, read back, timed."""
+    """Base of the GPU runners: `frame()` = draw, wait for completion, read back, timed;
+    `warm_up()` first, so that no timed frame holds the driver's compile."""
 
     def draw(self) -> None:
         raise NotImplementedError
 
     def read(self) -> RenderResult:
         raise NotImplementedError
+
+    def warm_up(self) -> float:
+        """Use the program once before any timed frame and return the seconds it took.
+
+        A driver may compile a shader at its first use rather than when the program is
+        built: llvmpipe does at the first draw (1.2 s for Barth's decic with `exact` at
+        256², then 0.04 s a frame), lavapipe at the first dispatch, PoCL at the first
+        launch of a work-group size. That compile is reported as its own figure
+        (`timing.compile`) and kept out of `timing.frame`. The default uses one whole
+        frame (read back, so it has waited); a runner that can trigger its compile with
+        less work (GL: one pixel) overrides `first_use`."""
+        start = time.perf_counter()
+        self.first_use()
+        return time.perf_counter() - start
+
+    def first_use(self) -> None:
+        self.draw()
+        self.read()
 
     def frame(self) -> RenderResult:
         start = time.perf_counter()

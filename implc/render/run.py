@@ -20,6 +20,8 @@ from .result import RenderResult
 
 
 class Runner(Protocol):
+    def warm_up(self) -> float | None: ...  # seconds of the first use (None: no driver)
+
     def frame(self) -> RenderResult: ...
 
     def release(self) -> None: ...
@@ -35,6 +37,10 @@ class _ReferenceRunner:
 
     def __init__(self, surface: Surface, width: int, height: int):
         self.surface, self.width, self.height = surface, width, height
+
+    def warm_up(self) -> None:
+        """Nothing is compiled: the reference is numpy on the CPU."""
+        return None
 
     def frame(self) -> RenderResult:
         from .reference import render_reference
@@ -91,15 +97,21 @@ def render(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
     params: str = "constant",
 ) -> RenderResult:
-    """Image and aux buffers of one frame; timing holds `setup` and `frame` seconds."""
+    """Image and aux buffers of one frame. `timing` holds, in seconds, `setup` (implc's
+    emit and the driver's program build), `compile` (the program's first use, where a
+    driver may compile it: see `TimedRunner.warm_up`; not for the reference) and `frame`
+    (one frame after that first use: what every later frame costs)."""
     start = time.perf_counter()
     runner = open_runner(surface, backend, method, constants, width, height, params)
     setup = time.perf_counter() - start
     try:
+        first_use = runner.warm_up()
         result = runner.frame()
     finally:
         runner.release()
     result.timing["setup"] = setup
+    if first_use is not None:
+        result.timing["compile"] = first_use
     return result
 
 
@@ -133,9 +145,11 @@ def metadata(
 def render_surface(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
     output: Path, params: str = "constant",
-) -> list[Path]:
+) -> tuple[list[Path], dict[str, float]]:
+    """Render and write the outputs; the paths written and the timing (see `render`)."""
     from .image_io import write_render
 
     result = render(surface, backend, method, constants, width, height, params)
-    return write_render(result, output,
-                        metadata(surface, backend, method, constants, result, params))
+    paths = write_render(result, output,
+                         metadata(surface, backend, method, constants, result, params))
+    return paths, result.timing
