@@ -109,7 +109,9 @@ class WgpuRunner(TimedRunner):
             self.view, self.width, self.height, self.params, self.values))
 
     def draw(self) -> None:
-        """Record and submit one frame: the compute pass and the copies out of it."""
+        """Record and submit one frame, the compute pass and the copies out of it, and
+        wait for it (a submit returns at once: without the wait, a timed frame would be
+        the submit's cost, and the next one would wait for this one)."""
         encoder = self.device.create_command_encoder()
         compute = encoder.begin_compute_pass()
         compute.set_pipeline(self.pipeline)
@@ -124,6 +126,9 @@ class WgpuRunner(TimedRunner):
         )
         encoder.copy_buffer_to_buffer(self.aux, 0, self.aux_read, 0, self.aux.size)
         self.device.queue.submit([encoder.finish()])
+        # queue.on_submitted_work_done_sync fails inside wgpu-py 0.32 (a callback type
+        # mismatch); reading 16 bytes back waits for the submitted work just as well
+        self.device.queue.read_buffer(self.aux, 0, 16)
 
     def read(self) -> RenderResult:
         """Map the copies (this waits for the frame) into a RenderResult, row 0 on top."""
