@@ -25,6 +25,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from math import comb
 
 import sympy
 
@@ -91,6 +92,15 @@ def function_name(quantities: Sequence[str]) -> str:
         return quantities[0]
     return "".join(_LETTER[q] for q in quantities)
 
+
+# From this degree the exact method isolates F's first root by Bernstein subdivision
+# (Descartes' rule of signs on the Bernstein coefficients of a node, stackless: the next
+# node follows from the current one) instead of the critical points level by level: it
+# visits 3-6 nodes a ray and stops at the first root, where the levels find every root
+# of every derivative. Measured at 512^2 (docs/RESULTS.md section 7): level by level
+# against Bernstein, 19.2 / 19.7 ms at degree 6, 32.2 / 24.0 at 7, 46.6 / 32.8 at 8, 97 /
+# 13-18 at 12.
+BERNSTEIN_FROM = 7
 
 # The exact method's highest degree: its solver is unrolled per derivative level (code
 # grows like n^2) and float32 Horner on degree-n coefficients loses about n bits;
@@ -164,6 +174,13 @@ class Solver:
     degree: int
     bottom: int  # the level solved in closed form: 2 (a quadratic) or 1 (linear)
     closed: tuple[str, ...]  # that level's coefficients a_0.. (printed), lowest first
+    # "levels" (critical points level by level) or "bernstein" (subdivision with
+    # Descartes' rule of signs), by degree: see BERNSTEIN_FROM
+    strategy: str = "levels"
+    # bernstein: b_1..b_n, the Bernstein coefficients on [0, 1] of sum e_k v^k (printed:
+    # b_i = sum_k C(i, k)/C(n, k) e_k; b_0 is e0), and the depth of a leaf node
+    bernstein: tuple[str, ...] = ()
+    depth: int = 0
 
 
 @dataclass(frozen=True)
@@ -595,5 +612,25 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     m = n - bottom
     closed = tuple(printer.doprint(v) for v in _derivative_coefficients(n, m))
     empty = Code((), ())
+    solver = Solver(n, bottom, closed)
+    if n >= BERNSTEIN_FROM:
+        e = [_sym(f"e{k}") for k in range(n + 1)]
+        bernstein = tuple(printer.doprint(sympy.Add(*(sympy.Rational(comb(i, k), comb(n, k))
+                                                      * e[k] for k in range(i + 1))))
+                          for i in range(1, n + 1))
+        solver = Solver(n, bottom, closed, "bernstein", bernstein, BERNSTEIN_DEPTH)
+        functions.append(ShaderFunction(
+            "Fh", "F at u by Horner alone: the Newton loop's value, inside a bracket whose "
+            f"ends P{n} confirmed", (("Ray", "ray"), ("real", "u")), "real", (),
+            (printer.doprint(_horner(c, u)),)))
+        printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
+                    ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
-                   empty, Solver(n, bottom, closed), carried)
+                   empty, solver, carried)
+
+
+# Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its
+# middle is a touching root when |F| there is within TOUCH), and a ray visits at most 96
+# nodes (measured: 3-6 on average, 34 at most on Barth's decic at 256^2).
+BERNSTEIN_DEPTH = 14
+BERNSTEIN_MAX_NODES = 96
