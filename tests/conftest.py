@@ -43,6 +43,20 @@ def require_gl():
         pytest.skip(f"no headless OpenGL: {err}")
 
 
+def require_backend(backend: str) -> None:
+    """The runtime of render backend gl, wgpu or cl (skip without it; fail under CI)."""
+    if backend == "gl":
+        require_gl()
+    elif backend == "wgpu":
+        from test_wgsl import require_wgpu
+
+        require_wgpu()
+    else:
+        from test_opencl import require_opencl
+
+        require_opencl()
+
+
 # --- the real browser (tests/test_view.py, tests/test_browser.py) --------------------------
 # Headless Chromium on this GPU-less machine: WebGL2 through ANGLE on SwiftShader, and
 # WebGPU through Dawn on SwiftShader's Vulkan. `--enable-unsafe-webgpu` and

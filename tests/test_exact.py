@@ -17,7 +17,7 @@ import jinja2
 import numpy as np
 import pytest
 from cases import EXAMPLES, PAPER
-from conftest import require_gl
+from conftest import require_backend, require_gl
 
 from implc.derive import polynomial_degree
 from implc.emit import emit, render_template
@@ -172,16 +172,7 @@ def test_bernstein_solver_matches_the_reference(name, backend):
     from implc.marcher import BERNSTEIN_FROM
     from implc.scene import View
 
-    if backend == "gl":
-        require_gl()
-    elif backend == "wgpu":
-        from test_wgsl import require_wgpu
-
-        require_wgpu()
-    else:
-        from test_opencl import require_opencl
-
-        require_opencl()
+    require_backend(backend)
     surface = load_surface(equation=HIGH_DEGREE[name])
     surface = type(surface)(name, surface.expr, view=View(clip_radius=1.2 if "chmutov" in name
                                                           else 1.0))

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy
-from conftest import require_gl
+from conftest import require_backend
 
 from implc.methods import METHODS
 from implc.render.run import render
@@ -55,19 +55,6 @@ COLOR_TOL = 2e-3
 BACKENDS = ("gl", "wgpu", "cl")
 SURFACES = ("cross-cap", "steiner")
 EXACT_NEGATION = {"cross-cap"}  # its -S program is the S program with every sign flipped
-
-
-def require_backend(backend: str) -> None:
-    if backend == "gl":
-        require_gl()
-    elif backend == "wgpu":
-        from test_wgsl import require_wgpu
-
-        require_wgpu()
-    else:
-        from test_opencl import require_opencl
-
-        require_opencl()
 
 
 def frame(surface: Surface, backend: str, method: str, **constants):

@@ -19,7 +19,7 @@ import re
 import numpy as np
 import pytest
 import sympy
-from conftest import require_gl
+from conftest import require_backend, require_gl
 from test_cli import implc
 
 from implc.emit import emit, param_uniforms
@@ -159,16 +159,7 @@ COMPILED = {"gl": "program", "wgpu": "pipeline", "cl": "kernel"}
 
 @pytest.mark.parametrize("backend", ["gl", "wgpu", "cl"])
 def test_runner_moves_parameters_without_compiling(backend):
-    if backend == "gl":
-        require_gl()
-    elif backend == "wgpu":
-        from test_wgsl import require_wgpu
-
-        require_wgpu()
-    else:
-        from test_opencl import require_opencl
-
-        require_opencl()
+    require_backend(backend)
     surface = load_surface("torus")
     runner = open_runner(surface, backend, "hessian", hessian(), SIZE, SIZE, params="uniform")
     compiled = getattr(runner, COMPILED[backend])
