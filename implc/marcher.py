@@ -585,7 +585,10 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     n = len(coefficients.outputs) - 1
     ray_fields, ray = _carry(carried, *_ray_setup(coefficients, printer))
     u = _sym("u")
-    for k in range(1, n):  # P_k = F^(n-k): the derivatives, which only place the pieces
+    bernstein = n >= BERNSTEIN_FROM
+    # P_k = F^(n-k): the derivatives, which only place the pieces (level by level), or F'
+    # alone (Bernstein subdivision's Newton needs no other)
+    for k in ((n - 1,) if bernstein else range(1, n)):
         m = n - k
         what = "F" + "'" * m if m < 4 else f"F^({m})"
         value, powers = _estrin_derivative(n, m, u)
@@ -613,12 +616,12 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     closed = tuple(printer.doprint(v) for v in _derivative_coefficients(n, m))
     empty = Code((), ())
     solver = Solver(n, bottom, closed)
-    if n >= BERNSTEIN_FROM:
+    if bernstein:
         e = [_sym(f"e{k}") for k in range(n + 1)]
-        bernstein = tuple(printer.doprint(sympy.Add(*(sympy.Rational(comb(i, k), comb(n, k))
-                                                      * e[k] for k in range(i + 1))))
-                          for i in range(1, n + 1))
-        solver = Solver(n, bottom, closed, "bernstein", bernstein, BERNSTEIN_DEPTH)
+        coefficients = tuple(printer.doprint(sympy.Add(*(
+            sympy.Rational(comb(i, k), comb(n, k)) * e[k] for k in range(i + 1))))
+            for i in range(1, n + 1))
+        solver = Solver(n, bottom, closed, "bernstein", coefficients, BERNSTEIN_DEPTH)
         functions.append(ShaderFunction(
             "Fh", "F at u by Horner alone: the Newton loop's value, inside a bracket whose "
             f"ends P{n} confirmed", (("Ray", "ray"), ("real", "u")), "real", (),

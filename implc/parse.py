@@ -380,10 +380,7 @@ def fold_constants(expr: sympy.Expr) -> sympy.Expr:
 
 def _number(constant: sympy.Expr) -> sympy.Expr:
     """A constant the builder checked (finite and real) as a FOLD_DIGITS-digit Float."""
-    value = constant.evalf(FOLD_DIGITS)
-    if value.is_Rational:
-        return value
-    return sympy.Float(value, FOLD_DIGITS)
+    return constant.evalf(FOLD_DIGITS)
 
 
 def _build_symbolic(

@@ -6,7 +6,14 @@ import sympy
 
 from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
-from .marcher import AUTO_MAX_DEGREE, coefficient_program, evaluations, ray_quantity_ops
+from .marcher import (
+    AUTO_MAX_DEGREE,
+    BERNSTEIN_FROM,
+    BERNSTEIN_MAX_NODES,
+    coefficient_program,
+    evaluations,
+    ray_quantity_ops,
+)
 from .methods import Method
 from .surface import Surface
 from .textform import to_text
@@ -60,8 +67,8 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
             "exact (root isolation of the ray polynomial; no marching):",
             f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
             f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
-            f"  derivatives P1..P{degree - 1} of F by Estrin's scheme; "
-            "F by Horner where its sign is certain, else S at the point",
+            *_solver_lines(degree),
+            "  F by Horner where its sign is certain, else S at the point",
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
@@ -83,3 +90,15 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
 def _short(expr: sympy.Expr, limit: int = 200) -> str:
     text = to_text(expr)[: -len(" = 0")]
     return text if len(text) <= limit else text[:limit] + " ..."
+
+
+def _solver_lines(degree: int) -> list[str]:
+    """The exact solver's strategy at this degree and its work per node or level."""
+    if degree >= BERNSTEIN_FROM:
+        shift = degree * (degree + 1) // 2
+        return [f"  strategy: Bernstein subdivision (degree >= {BERNSTEIN_FROM}): per node a "
+                f"Taylor shift ({shift} multiply-adds), {degree} scalings and {degree} "
+                f"Bernstein sums; 3-6 nodes a ray measured, at most {BERNSTEIN_MAX_NODES}; "
+                "Newton on F with F' by Estrin's scheme"]
+    return [f"  strategy: critical points level by level (degree < {BERNSTEIN_FROM}): "
+            f"derivatives P1..P{degree - 1} of F by Estrin's scheme"]

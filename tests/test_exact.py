@@ -185,3 +185,13 @@ def test_bernstein_solver_matches_the_reference(name, backend):
     assert reference.hit.sum() > 0.1 * size * size, "the surface should fill the view"
     assert m["false_hits"] == 0, m
     assert m["missed_hits"] <= 0.001 * size * size and m["wrong_root"] <= 0.001 * size**2, m
+
+
+def test_show_names_the_solver_strategy():
+    from implc.methods import get_method
+    from implc.show import describe
+
+    high = load_surface(equation=HIGH_DEGREE["chmutov-8"])
+    assert "strategy: Bernstein subdivision" in describe(high, get_method("exact"))
+    low = describe(load_surface("cross-cap"), get_method("exact"))
+    assert "strategy: critical points level by level" in low
