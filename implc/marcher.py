@@ -105,7 +105,7 @@ BERNSTEIN_FROM = 7
 # The exact method's highest degree: its solver is unrolled per derivative level (code
 # grows like n^2) and float32 Horner on degree-n coefficients loses about n bits;
 # measured correct up to 12 (docs/RESULTS.md, "The exact method").
-EXACT_MAX_DEGREE = 12
+EXACT_MAX_DEGREE = 20
 
 
 def check_exact(expr: sympy.Expr) -> int:
@@ -177,9 +177,10 @@ class Solver:
     # "levels" (critical points level by level) or "bernstein" (subdivision with
     # Descartes' rule of signs), by degree: see BERNSTEIN_FROM
     strategy: str = "levels"
-    # bernstein: b_1..b_n, the Bernstein coefficients on [0, 1] of sum e_k v^k (printed:
-    # b_i = sum_k C(i, k)/C(n, k) e_k; b_0 is e0), and the depth of a leaf node
-    bernstein: tuple[str, ...] = ()
+    # bernstein: the lets (name, printed value) that give b0..bn, the Bernstein
+    # coefficients of sum e_k w^k on w in [-1, 1] (see _bernstein_lets), and the depth of
+    # a leaf node
+    bernstein: tuple[tuple[str, str], ...] = ()
     depth: int = 0
 
 
@@ -617,10 +618,7 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     empty = Code((), ())
     solver = Solver(n, bottom, closed)
     if bernstein:
-        e = [_sym(f"e{k}") for k in range(n + 1)]
-        coefficients = tuple(printer.doprint(sympy.Add(*(
-            sympy.Rational(comb(i, k), comb(n, k)) * e[k] for k in range(i + 1))))
-            for i in range(1, n + 1))
+        coefficients = _bernstein_lets(n, printer)
         solver = Solver(n, bottom, closed, "bernstein", coefficients, BERNSTEIN_DEPTH)
         functions.append(ShaderFunction(
             "Fh", "F at u by Horner alone: the Newton loop's value, inside a bracket whose "
@@ -630,6 +628,33 @@ def _lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
                    empty, solver, carried)
+
+
+def _bernstein_lets(n: int, printer) -> tuple[tuple[str, str], ...]:
+    """b_0..b_n, the Bernstein coefficients of a node's polynomial sum_k e_k w^k on
+    w in [-1, 1] (e_k: the Taylor coefficients about the node's middle, scaled to its half
+    width): b_i = sum_k beta_ik e_k with beta_ik = sum_j C(i, j) C(n-i, k-j) (-1)^(k-j) /
+    C(n, k), the blossom of w^k at i ones and n-i minus ones, so |beta_ik| <= 1 and the
+    rounding of b is bounded by n eps sum |e_k| (about the node's start, as before, the
+    bound grew like 3^n sum |e_k|: 57 wrong or missed pixels of 16,384 at degree 14).
+    beta_(n-i),k = (-1)^k beta_ik: the even part (k even) and the odd part are summed once
+    for i <= n/2 and give b_i and b_(n-i) by a sum and a difference."""
+    e = [_sym(f"e{k}") for k in range(n + 1)]
+
+    def beta(i: int, k: int) -> sympy.Rational:
+        return sympy.Rational(sum(comb(i, j) * comb(n - i, k - j) * (-1) ** (k - j)
+                                  for j in range(k + 1)), comb(n, k))
+
+    lets: list[tuple[str, str]] = []
+    for i in range(n // 2 + 1):
+        even = sympy.Add(*(beta(i, k) * e[k] for k in range(0, n + 1, 2)))
+        odd = sympy.Add(*(beta(i, k) * e[k] for k in range(1, n + 1, 2)))
+        if 2 * i == n:  # the middle coefficient: its odd part is 0
+            lets.append((f"b{i}", printer.doprint(even)))
+            continue
+        lets += [(f"be{i}", printer.doprint(even)), (f"bo{i}", printer.doprint(odd)),
+                 (f"b{i}", f"be{i} + bo{i}"), (f"b{n - i}", f"be{i} - bo{i}")]
+    return tuple(lets)
 
 
 # Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its

@@ -145,8 +145,8 @@ def test_exact_refuses_non_polynomials(example):
 
 
 def test_exact_refuses_degrees_beyond_its_limit():
-    surface = load_surface(equation="x^14 + y^14 + z^14 - 1")
-    with pytest.raises(InputError, match="degree up to 12.*degree 14"):
+    surface = load_surface(equation="x^22 + y^22 + z^22 - 1")
+    with pytest.raises(InputError, match="degree up to 20.*degree 22"):
         emit(surface, "glsl", "exact")
 
 
