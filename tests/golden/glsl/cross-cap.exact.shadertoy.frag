@@ -7,7 +7,7 @@
 
 // Method constants (implc compile options).
 const float TOUCH = 1e-13;
-const float HORNER_ERR = 9.5367431640625e-07;
+const float ROUND_ERR = 9.5367431640625e-07;
 const float XTOL = 1e-06;
 const float CTOL = 0.0003;
 const int NEWTON_STEPS = 12;
@@ -75,10 +75,12 @@ float P3(Ray ray, float u) {
     return (3.0*ray.c3 + 4.0*ray.c4*u)*u_2 + (ray.c1 + 2.0*ray.c2*u);
 }
 
-// F at u = t - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Estrin's value where its sign is certain, else S at the point
 float P4(Ray ray, float u) {
-    float h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return (abs(h) > HORNER_ERR*ray.size ? h : S(ray.o + u*ray.d));
+    float u_2 = u*u;
+    float u_4 = u_2*u_2;
+    float h = ray.c4*u_4 + ((ray.c2 + ray.c3*u)*u_2 + (ray.c0 + ray.c1*u));
+    return (abs(h) > ROUND_ERR*ray.size ? h : S(ray.o + u*ray.d));
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)

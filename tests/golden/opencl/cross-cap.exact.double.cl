@@ -21,7 +21,7 @@
 
 // Method constants (implc compile options).
 __constant double TOUCH = 1e-13;
-__constant double HORNER_ERR = 1.7763568394002505e-15;
+__constant double ROUND_ERR = 1.7763568394002505e-15;
 __constant double XTOL = 1e-06;
 __constant double CTOL = 0.0003;
 __constant int NEWTON_STEPS = 12;
@@ -89,10 +89,12 @@ double P3(Ray ray, double u) {
     return (3.0*ray.c3 + 4.0*ray.c4*u)*u_2 + (ray.c1 + 2.0*ray.c2*u);
 }
 
-// F at u = t - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Estrin's value where its sign is certain, else S at the point
 double P4(Ray ray, double u) {
-    double h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return (fabs(h) > HORNER_ERR*ray.size ? h : S(ray.o + u*ray.d));
+    double u_2 = u*u;
+    double u_4 = u_2*u_2;
+    double h = ray.c4*u_4 + ((ray.c2 + ray.c3*u)*u_2 + (ray.c0 + ray.c1*u));
+    return (fabs(h) > ROUND_ERR*ray.size ? h : S(ray.o + u*ray.d));
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)

@@ -21,7 +21,7 @@
 
 // Method constants (implc compile options).
 __constant float CROSS_CAP_TOUCH = 1e-13f;
-__constant float CROSS_CAP_HORNER_ERR = 9.5367431640625e-07f;
+__constant float CROSS_CAP_ROUND_ERR = 9.5367431640625e-07f;
 __constant float CROSS_CAP_XTOL = 1e-06f;
 __constant float CROSS_CAP_CTOL = 0.0003f;
 __constant int CROSS_CAP_NEWTON_STEPS = 12;
@@ -89,10 +89,12 @@ float cross_cap_P3(cross_cap_Ray ray, float u) {
     return (3.0f*ray.c3 + 4.0f*ray.c4*u)*u_2 + (ray.c1 + 2.0f*ray.c2*u);
 }
 
-// F at u = t - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Estrin's value where its sign is certain, else S at the point
 float cross_cap_P4(cross_cap_Ray ray, float u) {
-    float h = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return (fabs(h) > CROSS_CAP_HORNER_ERR*ray.size ? h : cross_cap_S(ray.o + u*ray.d));
+    float u_2 = u*u;
+    float u_4 = u_2*u_2;
+    float h = ray.c4*u_4 + ((ray.c2 + ray.c3*u)*u_2 + (ray.c0 + ray.c1*u));
+    return (fabs(h) > CROSS_CAP_ROUND_ERR*ray.size ? h : cross_cap_S(ray.o + u*ray.d));
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)

@@ -29,7 +29,7 @@ struct Uniforms {
 
 // Method constants (implc compile options).
 const TOUCH: f32 = 1e-13f;
-const HORNER_ERR: f32 = 9.5367431640625e-07f;
+const ROUND_ERR: f32 = 9.5367431640625e-07f;
 const XTOL: f32 = 1e-06f;
 const CTOL: f32 = 0.0003f;
 const NEWTON_STEPS: i32 = 12;
@@ -93,10 +93,12 @@ fn P3(ray: Ray, u: f32) -> f32 {
     return (3.0f*ray.c3 + 4.0f*ray.c4*u)*u_2 + (ray.c1 + 2.0f*ray.c2*u);
 }
 
-// F at u = t - sm: Horner's value where its sign is certain, else S at the point
+// F at u = t - sm: Estrin's value where its sign is certain, else S at the point
 fn P4(ray: Ray, u: f32) -> f32 {
-    let h: f32 = ray.c0 + u*(ray.c1 + u*(ray.c2 + u*(ray.c3 + ray.c4*u)));
-    return select(S(ray.o + u*ray.d), h, abs(h) > HORNER_ERR*ray.size);
+    let u_2: f32 = u*u;
+    let u_4: f32 = u_2*u_2;
+    let h: f32 = ray.c4*u_4 + ((ray.c2 + ray.c3*u)*u_2 + (ray.c0 + ray.c1*u));
+    return select(S(ray.o + u*ray.d), h, abs(h) > ROUND_ERR*ray.size);
 }
 
 // sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit (the reference's own: 1e-12 sum |a_k| s^k)
