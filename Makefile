@@ -87,11 +87,12 @@ bench-baseline: setup
 	    -o results/baseline-$$size/ || exit 1; \
 	done
 
-# Point versus ray-poly evaluation (accuracy, speed) and the cost-growth plot (degree 2-12).
+# Point versus ray-poly evaluation (accuracy, speed), and the degree sweep (exact against
+# taylor and hessian, degree 2-20, docs/RESULTS.md section 7) with its plot: ~50 minutes.
 forms: setup
 	$(PY) scripts/eval_forms.py accuracy --size 512 cross-cap miter steiner roman torus tooth \
 	  sphere kummer cayley clebsch ding-dong whitney-umbrella barth-sextic heart
-	$(PY) scripts/eval_forms.py sweep --size 256 --frames 15 --methods taylor --plot docs/cost-growth.png
+	$(PY) scripts/eval_forms.py sweep --size 512 --frames 5 --degrees 2-20 --plot docs/cost-growth.png
 
 # Fuzzing (tests/test_fuzz.py) at FUZZ_SCALE times the short pass that `make test` runs
 # (FUZZ_PATH_SCALE for the slower whole-path tests), a fresh seed each run: 100,000+

@@ -1,28 +1,32 @@
-"""Point versus ray-poly evaluation: accuracy against the exact reference, frame time and
-compile time, on named surfaces and on degree sweeps (docs/RESULTS.md, "Evaluation
-forms", and docs/cost-growth.png).
+"""Point versus ray-poly evaluation on named surfaces, and the degree sweep (exact against
+taylor and hessian, degree 2-20): accuracy against the exact reference, frame time and
+compile time (docs/RESULTS.md, "Evaluation forms" and "The degree sweep";
+docs/cost-growth.png).
 
     python scripts/eval_forms.py accuracy --size 512 cross-cap miter ...   markdown table
-    python scripts/eval_forms.py sweep --size 256 --plot docs/cost-growth.png
+    python scripts/eval_forms.py sweep --size 512 --plot docs/cost-growth.png
 
 Each surface's programs (one per form and method) are timed in turns in one GL context
-(llvmpipe here), one warm-up frame then --frames frames, medians; compile time is a cold
-`implc compile` subprocess (imports included), median of 3.
+(llvmpipe here), one warm-up frame then --frames frames, medians. The sweep's compile
+times are implc's emit (in process) and the driver's (program build and first draw, with
+Mesa's shader cache off).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
-import subprocess
-import sys
 import time
 
-from implc.bench import time_interleaved
-from implc.methods import get_method
-from implc.metrics import compare
-from implc.render.run import open_runner
-from implc.surface import load_surface
+os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "true")  # compile times are cold
+
+from implc.bench import time_interleaved  # noqa: E402
+from implc.marcher import choose_form  # noqa: E402
+from implc.methods import get_method  # noqa: E402
+from implc.metrics import compare  # noqa: E402
+from implc.render.run import open_runner  # noqa: E402
+from implc.surface import load_surface  # noqa: E402
 
 FORMS = ("point", "ray-poly")
 
@@ -63,16 +67,6 @@ def measure(surface, methods: list[str], size: int, frames: int, exact: bool = F
             for key, s, result in zip(keys, seconds, last, strict=True)}
 
 
-def compile_seconds(args: list[str], repeats: int = 3) -> float:
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "implc", "compile", *args],
-                       check=True, capture_output=True)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
-
-
 def accuracy(names: list[str], methods: list[str], size: int, frames: int) -> None:
     print(f"| surface | method | {' | '.join(f'{f} ms' for f in FORMS)} | "
           f"{' | '.join(f'{f} false / missed / wrong' for f in FORMS)} |")
@@ -87,56 +81,97 @@ def accuracy(names: list[str], methods: list[str], size: int, frames: int) -> No
             print(f"| {name} | {method} | {times} | {counts} |", flush=True)
 
 
-def sweep(degrees: list[int], method: str, size: int, frames: int, plot: str | None) -> None:
+SWEEP_RUNS = (("exact", "auto"), ("taylor", "point"), ("taylor", "ray-poly"),
+              ("hessian", "auto"))
+
+
+def measure_sweep(surface, size: int, frames: int) -> dict:
+    """Per (method, form) of SWEEP_RUNS, timed in the same rounds: median ms, the metrics
+    against the reference, implc's emit seconds (in process, sympy included) and the
+    driver's compile seconds (program build plus first draw, llvmpipe compiling there;
+    the Mesa shader cache is off, see main)."""
+    from implc.emit import emit
+
+    reference = open_runner(surface, "reference", "", get_method("taylor").defaults,
+                            size, size).frame()
+    runners, emits, builds = [], [], []
+    try:
+        for method, form in SWEEP_RUNS:
+            constants = get_method(method).constants(evaluation=form)
+            start = time.perf_counter()
+            emit(surface, "glsl", method, constants)
+            emits.append(time.perf_counter() - start)
+            start = time.perf_counter()  # emit again (cached) and build the GL program
+            runners.append(open_runner(surface, "gl", method, constants, size, size))
+            builds.append(time.perf_counter() - start)
+        seconds, last, first_use = time_interleaved(runners, frames)
+    finally:
+        for r in runners:
+            r.release()
+    return {key: {"ms": 1000 * statistics.median(s), "emit_s": e, "driver_s": b + f,
+                  **compare(result, reference)}
+            for key, s, result, e, b, f in zip(SWEEP_RUNS, seconds, last, emits, builds,
+                                               first_use, strict=True)}
+
+
+def sweep(degrees: list[int], size: int, frames: int, plot: str | None) -> None:
+    """The degree sweep (docs/RESULTS.md): exact against taylor (b = 0.01, both forms;
+    `taylor` in the ratio is the form `auto` picks) and hessian, per family and degree."""
     rows = []
-    print(f"| family | degree | {' | '.join(f'{method} {f} ms' for f in FORMS)} | exact ms | "
-          f"{' | '.join(f'{f} compile s' for f in FORMS)} | exact compile s | "
-          f"{' | '.join(f'{f} false / missed / wrong' for f in FORMS)} | "
-          "exact false / missed / wrong |")
-    print("|---|---|" + "---|" * (3 * len(FORMS) + 3))
+    print("| family | degree | exact ms | taylor point ms | taylor ray-poly ms | hessian ms | "
+          "exact / taylor | exact false / missed / wrong | taylor false / missed / wrong | "
+          "hessian false / missed / wrong | exact emit s | exact driver compile s |")
+    print("|---|---|" + "---|" * 10)
     for degree in degrees:
         for family, equation in sweep_equations(degree).items():
             surface = load_surface(equation=equation)
-            results = measure(surface, [method], size, frames, exact=True)
-            compile_s = {f: compile_seconds(["-e", equation, "-m", method, "--eval", f])
-                         for f in FORMS}
-            compile_s["exact"] = compile_seconds(["-e", equation, "-m", "exact"])
-            cells = [results[method, f] for f in FORMS] + [results["exact", "ray-poly"]]
-            rows.append((family, degree, cells, compile_s))
+            r = measure_sweep(surface, size, frames)
+            taylor = r["taylor", choose_form(surface.expr)]
+            exact = r["exact", "auto"]
+            rows.append((family, degree, r, exact["ms"] / taylor["ms"]))
+            counts = [f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
+                      for c in (exact, taylor, r["hessian", "auto"])]
             print(f"| {family} | {degree} | "
-                  + " | ".join(f"{c['ms']:.1f}" for c in cells) + " | "
-                  + " | ".join(f"{compile_s[f]:.2f}" for f in (*FORMS, "exact")) + " | "
-                  + " | ".join(f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
-                               for c in cells) + " |", flush=True)
+                  + " | ".join(f"{r[k]['ms']:.1f}" for k in SWEEP_RUNS)
+                  + f" | {exact['ms'] / taylor['ms']:.2f} | " + " | ".join(counts)
+                  + f" | {exact['emit_s']:.2f} | {exact['driver_s']:.2f} |", flush=True)
     if plot:
-        _plot(rows, method, size, plot)
+        _plot(rows, size, plot)
 
 
-def _plot(rows, method: str, size: int, path: str) -> None:
+def _plot(rows, size: int, path: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4), dpi=110)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2), dpi=110)
+    colors = dict(zip(SWEEP_RUNS, ("tab:green", "tab:blue", "tab:orange", "tab:red"),
+                      strict=True))
     for family, style in (("powers", "-"), ("chmutov", "--")):
         data = [r for r in rows if r[0] == family]
         degrees = [r[1] for r in data]
-        for k, form in enumerate((*FORMS, "exact")):
-            color = ("tab:blue", "tab:orange", "tab:green")[k]
-            label = f"{method} {form}" if form != "exact" else "exact"
-            axes[0].plot(degrees, [r[2][k]["ms"] for r in data], style, marker="o",
-                         color=color, label=f"{label}, {family}")
-            axes[1].plot(degrees, [r[3][form] for r in data], style, marker="o",
-                         color=color, label=f"{label}, {family}")
+        for key in SWEEP_RUNS:
+            label = key[0] if key[1] == "auto" else f"{key[0]} {key[1]}"
+            axes[0].plot(degrees, [r[2][key]["ms"] for r in data], style, marker="o",
+                         color=colors[key], label=f"{label}, {family}")
+        axes[1].plot(degrees, [r[3] for r in data], style, marker="o", color="tab:green",
+                     label=f"exact / taylor, {family}")
+        axes[2].plot(degrees, [r[2]["exact", "auto"]["driver_s"] for r in data], style,
+                     marker="o", color="tab:green", label=f"exact, driver, {family}")
+        axes[2].plot(degrees, [r[2]["exact", "auto"]["emit_s"] for r in data], style,
+                     marker="o", color="tab:purple", label=f"exact, implc emit, {family}")
+    axes[1].axhline(0.67, color="grey", lw=1, ls=":", label="goal 0.67")
     axes[0].set_title(f"frame time, {size}x{size}, llvmpipe")
     axes[0].set_ylabel("ms per frame (median)")
-    axes[1].set_title("compile time (cold `implc compile`)")
-    axes[1].set_ylabel("seconds")
+    axes[0].set_yscale("log")
+    axes[1].set_title("exact / taylor (b = 0.01) frame time")
+    axes[2].set_title("compile (Mesa shader cache off)")
+    axes[2].set_ylabel("seconds")
     for ax in axes:
         ax.set_xlabel("degree of S")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path)
     print(f"wrote {path}")
@@ -150,14 +185,14 @@ def main() -> None:
     ap.add_argument("--size", type=int, default=512)
     ap.add_argument("--frames", type=int, default=3)
     ap.add_argument("--methods", nargs="+", default=["taylor", "hessian"])
-    ap.add_argument("--degrees", default="2-12")
+    ap.add_argument("--degrees", default="2-20")
     ap.add_argument("--plot")
     args = ap.parse_intermixed_args()
     if args.mode == "accuracy":
         accuracy(args.surfaces, args.methods, args.size, args.frames)
     else:
         lo, hi = (int(v) for v in args.degrees.split("-"))
-        sweep(list(range(lo, hi + 1)), args.methods[0], args.size, args.frames, args.plot)
+        sweep(list(range(lo, hi + 1)), args.size, args.frames, args.plot)
 
 
 if __name__ == "__main__":
