@@ -40,9 +40,10 @@ from .fileio import (
     read_input,
     write_atomic,
 )
-from .marcher import AUTO_MAX_DEGREE, EVAL_CHOICES, EXACT_MAX_DEGREE
+from .marcher import AUTO_MAX_DEGREE, EVAL_CHOICES
 from .methods import METHODS, TAYLOR2_CHOICES, Constants
 from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
+from .solver import EXACT_MAX_DEGREE
 from .targets import TARGETS
 
 EPILOG = """\
@@ -461,7 +462,7 @@ def cmd_list(args) -> int:
 
 def _resolve_method(args, surface) -> None:
     """-m's default depends on the surface: exact where it applies, else hessian."""
-    from .marcher import default_method
+    from .solver import default_method
 
     if args.method is None:
         args.method = default_method(surface.expr)

@@ -6,15 +6,10 @@ import sympy
 
 from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
-from .marcher import (
-    AUTO_MAX_DEGREE,
-    BERNSTEIN_FROM,
-    BERNSTEIN_MAX_NODES,
-    coefficient_program,
-    evaluations,
-    ray_quantity_ops,
-)
+from .marcher import AUTO_MAX_DEGREE, evaluations
 from .methods import Method
+from .raypoly import coefficient_program, ray_quantity_ops
+from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES
 from .surface import Surface
 from .textform import to_text
 

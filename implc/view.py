@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .emit import emit, param_uniforms, render_template
-from .marcher import default_method
 from .methods import Constants, get_method
+from .solver import default_method
 from .surface import Surface
 
 # A slider spans value +- max(|value|, SLIDER_MIN_HALF_WIDTH) in SLIDER_TICKS steps.

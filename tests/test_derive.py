@@ -10,10 +10,10 @@ from cases import EXAMPLES
 
 from implc.derive import Derivatives
 from implc.emit import build_functions, emit, function_quantities
-from implc.marcher import _estrin, _estrin_derivative, _weighted_coefficients
 from implc.methods import METHODS
 from implc.numeric import evaluate, evaluate_program
 from implc.optimize import _sums_by_depth, arrange_by_depth
+from implc.raypoly import estrin, estrin_derivative, weighted_coefficients
 from implc.surface import load_surface
 from implc.symbols import DIRECTION, POINT
 from implc.targets import get_target
@@ -137,7 +137,7 @@ def test_estrin_evaluates_the_polynomial(degree, weighted):
     c = rng.normal(size=degree + 1)
     w = [int(v) for v in rng.integers(1, 40, size=degree + 1)] if weighted else None
     s = sympy.Symbol("s", real=True)
-    value, powers = _estrin([sympy.Float(v) for v in c], s, w)
+    value, powers = estrin([sympy.Float(v) for v in c], s, w)
     x = rng.uniform(-1.5, 1.5, 64)
     scope = evaluate_program(powers, [value], {s: x})[0]
     expected = np.polyval((c * (np.array(w) if w else 1))[::-1], x)
@@ -157,12 +157,12 @@ def _invariants(expr: sympy.Basic, varying: set) -> set:
 def test_second_derivative_reads_the_first_derivatives_invariants(degree):
     """F'' at a march point multiplies the coefficient products F' holds already (k c_k),
     its integer factors on the powers of s: up to degree 4 no loop invariant of its own
-    (measured 1.2-1.5 % a frame on the Steiner surface, marcher._weighted_coefficients),
+    (measured 1.2-1.5 % a frame on the Steiner surface, raypoly.weighted_coefficients),
     above it fewer than F'' over its own coefficients k(k-1) c_k; and it is F''."""
     s = sympy.Symbol("s", real=True)
     d1, p1 = _weighted_estrin(degree, 1, s)
     d2, p2 = _weighted_estrin(degree, 2, s)
-    own, p3 = _estrin_derivative(degree, 2, s)
+    own, p3 = estrin_derivative(degree, 2, s)
     varying = {s, *(k for k, _ in p1 + p2 + p3)}
     first = _invariants(d1, varying)
     extra = _invariants(d2, varying) - first
@@ -178,9 +178,9 @@ def test_second_derivative_reads_the_first_derivatives_invariants(degree):
 
 
 def _weighted_estrin(n: int, m: int, s: sympy.Symbol):
-    """F^(m) at s as the march evaluates it (marcher._estrin_function)."""
-    coefficients, weights = _weighted_coefficients(n, m)
-    return _estrin(coefficients, s, weights)
+    """F^(m) at s as the march evaluates it (raypoly.estrin_function)."""
+    coefficients, weights = weighted_coefficients(n, m)
+    return estrin(coefficients, s, weights)
 
 
 def test_degree_is_computed_once_per_compile():
@@ -188,7 +188,7 @@ def test_degree_is_computed_once_per_compile():
     default method, the evaluation form, exact's check and the ray coefficients all ask
     it, and one compile computes it once."""
     from implc.derive import polynomial_degree
-    from implc.marcher import default_method
+    from implc.solver import default_method
 
     surface = load_surface(equation="x^4 + y^4 + z^4 - 1 + x y z/7")  # fresh: not cached
     before = polynomial_degree.cache_info()

@@ -169,8 +169,8 @@ def test_bernstein_solver_matches_the_reference(name, backend):
     """No false hit; missed and wrong-root pixels within 0.1 % at 64² on every backend
     (measured: 0, 0 and 0 on all nine); the program is the Bernstein solver's. Fails
     when the Taylor shift is broken (a sign flipped in it)."""
-    from implc.marcher import BERNSTEIN_FROM
     from implc.scene import View
+    from implc.solver import BERNSTEIN_FROM
 
     require_backend(backend)
     surface = load_surface(equation=HIGH_DEGREE[name])

@@ -1,0 +1,165 @@
+"""The ray polynomial F(s) = S(o + s d) = sum c_k s^k: its coefficients once per ray
+(`ray_of`), and its values and derivatives at a parameter by Estrin's scheme, printed as
+shader functions and pieces of them (the ray-poly evaluation form and the exact solver
+read them)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from functools import lru_cache
+
+import sympy
+
+from .derive import ray_coefficients
+from .errors import InputError
+from .optimize import Program, count_ops, optimize
+from .pieces import COMPONENT, RETURN_TYPE, Code, ShaderFunction, function_name, printed_lets, sym
+from .symbols import DIRECTION, POINT
+
+DERIVATIVE_ORDER = {"S": 0, "dS": 1, "d2S": 2}
+
+
+@lru_cache(maxsize=32)
+def coefficient_program(expr: sympy.Expr) -> Program:
+    """The ray polynomial's coefficients c_0..c_n from (o, d), jointly CSE'd."""
+    coefficients = ray_coefficients(expr)
+    if coefficients is None:
+        raise InputError("the ray-poly form needs a polynomial surface")
+    return optimize(list(coefficients), POINT + DIRECTION)
+
+
+def ray_name(quantities: tuple[str, ...]) -> str:
+    return "ray_" + function_name(quantities)
+
+
+def ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
+    """The ray record's fields and ray_of's body. The polynomial is expanded about the
+    middle of the march interval: the record's origin is o = ro + sm rd and
+    F(s) = S(o + s d) = sum c_k s^k, so |s| is at most hr, half the chord): about the
+    entry point its terms would be up to 3^n times larger
+    for the same sum, and float32 Horner loses that much more to cancellation. `size`,
+    sum |c_k| hr^k, bounds the terms of F on the interval: the unit of the rounding
+    error in the exact solver's F. Storing the coefficients of F' and F'' as well
+    measured slower on llvmpipe (a larger record, the same loop-invariant products)."""
+    n = len(coefficients.outputs) - 1
+    lets = [("real", v.name, f"oc.{c}") for v, c in zip(POINT, COMPONENT, strict=True)]
+    lets += [("real", v.name, f"rd.{c}") for v, c in zip(DIRECTION, COMPONENT, strict=True)]
+    lets += [("real", s.name, printer.doprint(v)) for s, v in coefficients.assignments]
+    lets += [("real", f"c{k}", printer.doprint(o)) for k, o in enumerate(coefficients.outputs)]
+    size = horner([sympy.Abs(sym(f"c{k}")) for k in range(n + 1)], sym("hr"))
+    lets.append(("real", "size", printer.doprint(size)))
+    fields = (("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"),)
+    fields += tuple(("real", f"c{k}", f"coefficient of u^{k}") for k in range(n + 1))
+    return fields, Code(tuple(lets), ("size", *(f"c{k}" for k in range(n + 1))))
+
+
+def from_ray(carried: tuple[tuple[str, str], ...]) -> list[str]:
+    """The carried arguments as a function of the ray reads them: ray.params, ..."""
+    return [f"ray.{name}" for _, name in carried]
+
+
+def carry(carried: tuple[tuple[str, str], ...], fields: tuple,
+           ray: Code) -> tuple[tuple, Code]:
+    """The ray record with the carried arguments as fields (ray_of takes them)."""
+    fields += tuple((kind, name, "carried for the functions that evaluate S")
+                    for kind, name in carried)
+    return fields, Code(ray.lets, ray.values + tuple(name for _, name in carried))
+
+
+def horner(coefficients: Sequence[sympy.Expr], x: sympy.Expr) -> sympy.Expr:
+    """sum_k coefficients[k] x^k as a Horner sum."""
+    value: sympy.Expr = sympy.S.Zero
+    for c in reversed(coefficients):
+        value = value * x + c
+    return value
+
+
+def derivative_coefficients(n: int, m: int) -> list[sympy.Expr]:
+    """The coefficients k!/(k-m)! c_k of F^(m) over the ray record's c0..cn (loop
+    invariant; storing them in the record measured no faster, see ray_setup)."""
+    return [sympy.ff(k, m) * sym(f"ray.c{k}") for k in range(m, n + 1)]
+
+
+def estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol,
+            weights: Sequence[int] | None = None
+            ) -> tuple[sympy.Expr, list[tuple[sympy.Symbol, sympy.Expr]]]:
+    """sum_k weights[k] coefficients[k] x^k by Estrin's scheme, (c0 + c1 x) + x^2 (c2 + c3 x),
+    pairs of pairs by x^4, ...; and the powers x^2, x^4, ... it reads, as lets. Its
+    dependency chain is about 2 log2(n) operations where Horner's is 2n (GPU compilers,
+    llvmpipe among them, keep a*b + c as two operations), and a march step is bound by its
+    chain: with the march point of values_at (_MARCH_POINT), 2-6 % a frame
+    (docs/RESULTS.md, section 3).
+
+    A term's integer weight is multiplied onto the power of x it meets where it meets one,
+    c3*(2.0*x), not onto its coefficient: in a march loop the coefficients are loop
+    invariants, and a compiler keeps every product of them in a register for the whole
+    loop (see weighted_coefficients)."""
+    # a term not yet combined is (coefficient, weight); a combined one is an expression
+    terms: list = list(zip(coefficients, weights or [1] * len(coefficients), strict=True))
+    powers, step = [], x
+
+    def value(term) -> sympy.Expr:
+        if not isinstance(term, tuple):
+            return term
+        c, w = term
+        return c if w == 1 else sympy.Mul(w, c)
+
+    def times(term, power: sympy.Expr) -> sympy.Expr:
+        if not isinstance(term, tuple):
+            return sympy.Mul(term, power, evaluate=False)
+        c, w = term
+        return sympy.Mul(c, power if w == 1 else sympy.Mul(w, power, evaluate=False),
+                         evaluate=False)
+
+    while len(terms) > 1:
+        terms = [sympy.Add(value(terms[i]), times(terms[i + 1], step), evaluate=False)
+                 if i + 1 < len(terms) else terms[i] for i in range(0, len(terms), 2)]
+        if len(terms) > 1:
+            square = sym(f"{x.name}_{2 ** (len(powers) + 1)}")
+            powers.append((square, sympy.Mul(step, step, evaluate=False)))
+            step = square
+    return (value(terms[0]) if terms else sympy.S.Zero), powers
+
+
+def ray_quantity_ops(n: int, quantity: str) -> int:
+    """Operations of a ray quantity (dS, d2S) of a degree-n ray polynomial by Estrin's
+    scheme as the march evaluates it (estrin_function), its powers of s and the integer
+    factors on them included, the coefficients taken as given (`implc show`)."""
+    m = DERIVATIVE_ORDER[quantity]
+    weights = weighted_coefficients(n, m)[1] if n >= m else [1]
+    value, powers = estrin([sym(f"a{k}") for k in range(len(weights))], sym("s"), weights)
+    return count_ops(value) + sum(count_ops(v) for _, v in powers)
+
+
+def estrin_derivative(n: int, m: int, x: sympy.Symbol):
+    """F^(m) at x by Estrin's scheme: (value, the lets of its powers of x)."""
+    return estrin(derivative_coefficients(n, m), x)
+
+
+def weighted_coefficients(n: int, m: int) -> tuple[list[sympy.Expr], list[int]]:
+    """F^(m)'s coefficients (m >= 1) written over those of F', k c_k, with the integer
+    weights (k-1)!/(k-m)! that make them k!/(k-m)! c_k (estrin puts each weight on the
+    power of s its term meets). So F'' in a march loop reads only the loop invariants F'
+    holds already (up to degree 4): measured on the quartic paper surfaces (hessian,
+    1024^2), the march step as fast as taylor's, where F'' over its own coefficients (6c3
+    and 12c4, two more values live for the whole loop) cost 1.2-1.5 % a frame on the
+    Steiner surface."""
+    ks = range(m, n + 1)
+    return [sympy.Mul(k, sym(f"ray.c{k}")) for k in ks], [int(sympy.ff(k - 1, m - 1)) for k in ks]
+
+
+def estrin_function(quantities: tuple[str, ...], n: int, printer) -> ShaderFunction:
+    """F' and/or F'' at march parameter s (measured from the ray record's origin, the
+    expansion point), each by Estrin's scheme in s."""
+    powers: dict[sympy.Symbol, sympy.Expr] = {}  # s^2, s^4, ...: shared by F' and F''
+    outputs = []
+    for q in quantities:
+        coefficients, weights = weighted_coefficients(n, DERIVATIVE_ORDER[q])
+        value, used = estrin(coefficients, sym("s"), weights)
+        powers.update(used)
+        outputs.append(printer.doprint(value))
+    what = ", ".join(quantities)
+    return ShaderFunction(ray_name(quantities),
+                          f"{what} at march parameter s: Estrin's scheme on the ray polynomial",
+                          (("Ray", "ray"), ("real", "s")), RETURN_TYPE[len(outputs)],
+                          tuple(printed_lets(powers.items(), printer)), tuple(outputs))

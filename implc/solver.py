@@ -1,0 +1,209 @@
+"""The `exact` method: root isolation on the ray polynomial, lowered to the pieces of
+templates/solver.j2 (critical points level by level up to degree 6, Bernstein subdivision
+with Descartes' rule of signs from degree 7; see BERNSTEIN_FROM), and the rule that makes
+it the default method."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import comb
+
+import sympy
+
+from .derive import polynomial_degree
+from .errors import InputError
+from .methods import Constants
+from .pieces import Code, Marcher, ShaderFunction, build_programs, point_function, printed_lets, sym
+from .raypoly import (
+    carry,
+    coefficient_program,
+    derivative_coefficients,
+    estrin,
+    estrin_derivative,
+    from_ray,
+    horner,
+    ray_setup,
+)
+
+# From this degree the exact method isolates F's first root by Bernstein subdivision
+# (Descartes' rule of signs on the Bernstein coefficients of a node, stackless: the next
+# node follows from the current one) instead of the critical points level by level: it
+# visits 3-6 nodes a ray and stops at the first root, where the levels find every root
+# of every derivative. Measured at 512^2 (docs/RESULTS.md section 7): level by level
+# against Bernstein, 19.2 / 19.7 ms at degree 6, 32.2 / 24.0 at 7, 46.6 / 32.8 at 8, 97 /
+# 13-18 at 12.
+BERNSTEIN_FROM = 7
+
+# The exact method's highest degree. Float32 root isolation loses accuracy with the
+# degree; measured at 512^2 (issue 21's note): 12 bad pixels of 262,144 at degree 14 and
+# 17 at 18, against 0-3 at 10-12 (the limit there is the float32 ray coefficients).
+EXACT_MAX_DEGREE = 20
+
+
+def check_exact(expr: sympy.Expr) -> int:
+    """The degree of S, or an InputError saying why `-m exact` does not apply."""
+    from .methods import METHODS
+
+    marching = ", ".join(m for m, meth in METHODS.items() if not meth.solves)
+    degree = polynomial_degree(expr)
+    if degree is None:
+        raise InputError("-m exact needs a polynomial surface (it isolates the roots of the "
+                         f"ray polynomial); this one is not: use one of {marching}")
+    if degree > EXACT_MAX_DEGREE:
+        raise InputError(f"-m exact supports degree up to {EXACT_MAX_DEGREE} (float32 root "
+                         f"isolation is measured correct up to there); this surface has "
+                         f"degree {degree}: use one of {marching}")
+    return degree
+
+
+def default_method(expr: sympy.Expr) -> str:
+    """The method `-m` defaults to: `exact` where it applies (polynomials up to
+    EXACT_MAX_DEGREE; measured the most accurate there, and the fastest up to degree 6),
+    else `hessian`."""
+    degree = polynomial_degree(expr)
+    return "exact" if degree is not None and degree <= EXACT_MAX_DEGREE else "hessian"
+
+
+@dataclass(frozen=True)
+class Solver:
+    """What templates/solver.j2 needs for the `exact` method on a degree-n polynomial."""
+
+    degree: int
+    bottom: int  # the level solved in closed form: 2 (a quadratic) or 1 (linear)
+    closed: tuple[str, ...]  # that level's coefficients a_0.. (printed), lowest first
+    # "levels" (critical points level by level) or "bernstein" (subdivision with
+    # Descartes' rule of signs), by degree: see BERNSTEIN_FROM
+    strategy: str = "levels"
+    # bernstein: the lets (name, printed value) that give b0..bn, the Bernstein
+    # coefficients of sum e_k w^k on w in [-1, 1] (see bernstein_lets), and the depth of
+    # a leaf node
+    bernstein: tuple[tuple[str, str], ...] = ()
+    depth: int = 0
+    # bernstein: w_i = -1 + 2i/n (printed), where b_i sits in the node's control polygon,
+    # whose zero starts the Newton (see lower_solver)
+    nodes: tuple[str, ...] = ()
+
+
+def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
+    """ROUND_ERR: the rounding error of F (degree n) by Estrin's scheme is below
+    gamma_m sum |c_k| |u|^k with m = 3 ceil(log2(n + 1)) (each term meets at most that many
+    roundings: its power's squarings, its product, the sums up the tree), and m <= 2n for
+    n >= 1, so below 2n eps sum |c_k| |u|^k (eps: the unit roundoff, gamma_m ~ m eps); twice
+    that, in units of the ray record's `size`."""
+    eps = 2.0**-53 if getattr(printer, "precision", "float") == "double" else 2.0**-24
+    return ("real", prefix.upper() + "ROUND_ERR", printer.float_literal(4 * n * eps))
+
+
+def _value_function(name: str, n: int, printer, prefix: str,
+                    carried: tuple[tuple[str, str], ...]) -> ShaderFunction:
+    """F at u = t - sm, by Estrin's scheme where its sign is certain (ROUND_ERR), else S at
+    the point (see RAY_DERIVATIVES). Estrin's chain is about 2 log2(n) operations where
+    Horner's is 2n: measured on x^18 + y^18 + z^18 = 1 at 512^2 (with Fh), 8 % a frame."""
+    at_point = f"{prefix}S({', '.join(['ray.o + u*ray.d', *from_ray(carried)])})"
+    certain = f"{printer.doprint(sympy.Abs(sym('h')))} > {prefix.upper()}ROUND_ERR*ray.size"
+    value, powers = estrin(derivative_coefficients(n, 0), sym("u"))
+    return ShaderFunction(
+        name, "F at u = t - sm: Estrin's value where its sign is certain, else S at the "
+        "point", (("Ray", "ray"), ("real", "u")), "real",
+        (*printed_lets(powers, printer), ("real", "h", printer.doprint(value))),
+        (printer.print_select(certain, "h", at_point),))
+
+
+# --- the exact method: root isolation on the ray polynomial ------------------------------
+
+def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
+                  max_derived: int, carried: tuple[tuple[str, str], ...]) -> Marcher:
+    """The pieces of templates/solver.j2: S and grad at the point (shading, residual),
+    the ray record with the coefficients, and P_k (k = 1..n), the (n-k)-th derivative of
+    F, a degree-k polynomial in u = t - sm: by Estrin's scheme for k < n (the Newton loops
+    that place the critical points are bound by their chains: 7 % a frame on the quartics,
+    29 % at degree 12), F itself too, with the rounding bound ROUND_ERR states."""
+    programs = build_programs(expr, (("S",), ("grad",)), max_derived)
+    functions = [point_function(name, program, printer, carried)
+                 for name, program in programs.items()]
+    coefficients = coefficient_program(expr)
+    n = len(coefficients.outputs) - 1
+    ray_fields, ray = carry(carried, *ray_setup(coefficients, printer))
+    u = sym("u")
+    bernstein = n >= BERNSTEIN_FROM
+    # P_k = F^(n-k): the derivatives, which only place the pieces (level by level), or F'
+    # alone (Bernstein subdivision's Newton needs no other)
+    for k in ((n - 1,) if bernstein else range(1, n)):
+        m = n - k
+        what = "F" + "'" * m if m < 4 else f"F^({m})"
+        value, powers = estrin_derivative(n, m, u)
+        functions.append(ShaderFunction(
+            f"P{k}", f"P{k} = {what}, degree {k} in u = t - sm",
+            (("Ray", "ray"), ("real", "u")), "real", tuple(printed_lets(powers, printer)),
+            (printer.doprint(value),)))
+    # F itself, whose sign is the answer: Estrin where that sign is certain, else at the
+    # point (see RAY_DERIVATIVES)
+    functions.append(_value_function(f"P{n}", n, printer, prefix, carried))
+    c = [sym(f"ray.c{k}") for k in range(n + 1)]
+    functions.append(ShaderFunction(
+        "scale_at", "sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit "
+        "(the reference's own: 1e-12 sum |a_k| s^k)", (("Ray", "ray"), ("real", "u")), "real",
+        (), (printer.doprint(horner([sympy.Abs(ck) for ck in c], sympy.Abs(u))),)))
+    K = prefix.upper()
+    printed = (("real", K + "TOUCH", printer.float_literal(constants.touch)),
+               _round_err(n, printer, prefix),
+               ("real", K + "XTOL", printer.float_literal(constants.xtol)),
+               ("real", K + "CTOL", printer.float_literal(constants.ctol)),
+               ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))),
+               ("int", K + "CRIT_STEPS", str(int(constants.crit_steps))))
+    bottom = 2 if n >= 3 else 1
+    m = n - bottom
+    closed = tuple(printer.doprint(v) for v in derivative_coefficients(n, m))
+    empty = Code((), ())
+    solver = Solver(n, bottom, closed)
+    if bernstein:
+        coefficients = bernstein_lets(n, printer)
+        # Newton starts at the zero of the root node's control polygon (the points
+        # (w_i, b_i)), not at the secant of its ends: at degree 18 F is far steeper at one
+        # end than near the root, and the secant starts next to the other end. Measured on
+        # x^18 + y^18 + z^18 = 1 at 512^2: 6.3 -> 4.5 Newton steps a hit pixel, 7 % a frame.
+        nodes = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
+        solver = Solver(n, bottom, closed, "bernstein", coefficients, BERNSTEIN_DEPTH, nodes)
+        value, powers = estrin(c, u)
+        functions.append(ShaderFunction(
+            "Fh", "F at u by Estrin's scheme alone: the Newton loop's value, inside a bracket "
+            f"whose ends P{n} confirmed", (("Ray", "ray"), ("real", "u")), "real",
+            tuple(printed_lets(powers, printer)), (printer.doprint(value),)))
+        printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
+                    ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
+    return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
+                   empty, solver, carried)
+
+
+def bernstein_lets(n: int, printer) -> tuple[tuple[str, str], ...]:
+    """b_0..b_n, the Bernstein coefficients of a node's polynomial sum_k e_k w^k on
+    w in [-1, 1] (e_k: the Taylor coefficients about the node's middle, scaled to its half
+    width): b_i = sum_k beta_ik e_k with beta_ik = sum_j C(i, j) C(n-i, k-j) (-1)^(k-j) /
+    C(n, k), the blossom of w^k at i ones and n-i minus ones, so |beta_ik| <= 1 and the
+    rounding of b is bounded by n eps sum |e_k| (about the node's start, as before, the
+    bound grew like 3^n sum |e_k|: 57 wrong or missed pixels of 16,384 at degree 14).
+    beta_(n-i),k = (-1)^k beta_ik: the even part (k even) and the odd part are summed once
+    for i <= n/2 and give b_i and b_(n-i) by a sum and a difference."""
+    e = [sym(f"e{k}") for k in range(n + 1)]
+
+    def beta(i: int, k: int) -> sympy.Rational:
+        return sympy.Rational(sum(comb(i, j) * comb(n - i, k - j) * (-1) ** (k - j)
+                                  for j in range(k + 1)), comb(n, k))
+
+    lets: list[tuple[str, str]] = []
+    for i in range(n // 2 + 1):
+        even = sympy.Add(*(beta(i, k) * e[k] for k in range(0, n + 1, 2)))
+        odd = sympy.Add(*(beta(i, k) * e[k] for k in range(1, n + 1, 2)))
+        if 2 * i == n:  # the middle coefficient: its odd part is 0
+            lets.append((f"b{i}", printer.doprint(even)))
+            continue
+        lets += [(f"be{i}", printer.doprint(even)), (f"bo{i}", printer.doprint(odd)),
+                 (f"b{i}", f"be{i} + bo{i}"), (f"b{n - i}", f"be{i} - bo{i}")]
+    return tuple(lets)
+
+
+# Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its
+# middle is a touching root when |F| there is within TOUCH), and a ray visits at most 96
+# nodes (measured: 3-6 on average, 34 at most on Barth's decic at 256^2).
+BERNSTEIN_DEPTH = 14
+BERNSTEIN_MAX_NODES = 96
