@@ -19,7 +19,8 @@ from .targets import get_target
 # (surface key, method) -> whether its hand-written test is second order (Eq. 4, F''
 # in the interval) rather than first order (Eq. 3): the one switch of the template.
 BASELINES: dict[tuple[str, str], bool] = {("cross-cap", "taylor"): False,
-                                          ("cross-cap", "hessian"): True}
+                                          ("cross-cap", "hessian"): True,
+                                          ("barth-decic", "exact"): False}
 
 
 def has_baseline(key: str, method: str) -> bool:
