@@ -17,7 +17,7 @@ import jinja2
 import numpy as np
 import pytest
 from cases import EXAMPLES, PAPER
-from conftest import require_backend, require_gl
+from conftest import require_backend, require_gl, require_tool
 
 from implc.derive import polynomial_degree
 from implc.emit import emit, render_template
@@ -216,3 +216,35 @@ def test_bernstein_solver_holds_at_degree_14(backend):
     assert reference.hit.sum() > 0.1 * size * size, "the knot should fill the view"
     assert m["false_hits"] == 0, m
     assert m["missed_hits"] + m["wrong_root"] <= 0.001 * size * size, m
+
+
+def _degree_20_cases():
+    from implc.targets import TARGETS
+
+    for name, target in TARGETS.items():
+        for flavor in target.flavors:
+            for precision in target.precisions:
+                for kind in ("program", "library"):
+                    yield name, flavor, precision, kind
+
+
+@pytest.mark.parametrize(("target", "flavor", "precision", "kind"), list(_degree_20_cases()),
+                         ids=lambda v: str(v))
+def test_exact_at_degree_20_validates_everywhere(target, flavor, precision, kind):
+    """The degree cap, 20, on every target, flavour, precision and emit: the Bernstein
+    solver's program and library at degree 20 pass the target's real compiler."""
+    from implc.targets import TARGETS
+    from implc.validate import validate_text
+
+    tool = {"glsl": "glslangValidator"}.get(target)
+    if tool:
+        require_tool(tool)
+    else:
+        require_backend({"wgsl": "wgpu", "opencl": "cl"}[target])
+    surface = load_surface(equation="x^20 + y^20 + z^20 - 1")
+    text = emit(surface, target, "exact", None, flavor, kind,
+                "deg20_" if kind == "library" else "", precision)
+    assert "Bernstein subdivision" in text
+    ext = ".glsl" if (target, kind) == ("glsl", "library") else TARGETS[target].extensions[0]
+    verdict = validate_text(text, target, f"degree20{ext}")
+    assert verdict.ok, verdict.render(f"degree20{ext}")
