@@ -5,6 +5,7 @@ docs/cost-growth.png).
 
     python scripts/eval_forms.py accuracy --size 512 cross-cap miter ...   markdown table
     python scripts/eval_forms.py sweep --size 512 --plot docs/cost-growth.png
+    python scripts/eval_forms.py gallery --size 512 barth-decic 163 285 ...  rows too
 
 Each surface's programs (one per form and method) are timed in turns in one GL context
 (llvmpipe here), one warm-up frame then --frames frames, medians. The sweep's compile
@@ -22,6 +23,7 @@ import time
 os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "true")  # compile times are cold
 
 from implc.bench import time_interleaved  # noqa: E402
+from implc.derive import polynomial_degree  # noqa: E402
 from implc.marcher import choose_form  # noqa: E402
 from implc.methods import get_method  # noqa: E402
 from implc.metrics import compare  # noqa: E402
@@ -139,6 +141,33 @@ def sweep(degrees: list[int], size: int, frames: int, plot: str | None) -> None:
         _plot(rows, size, plot)
 
 
+def gallery(names: list[str], size: int, frames: int) -> None:
+    """The sweep's measurement on named surfaces: bundled examples, or corpus rows by
+    number (the parameters as `implc corpus` gives them)."""
+    from implc.corpus import default_tsv, load_rows, row_surface
+
+    rows = {r.number: r for r in load_rows(default_tsv())} if any(
+        n.isdigit() for n in names) else {}
+    print("| surface | degree | exact ms | taylor point ms | taylor ray-poly ms | hessian ms | "
+          "exact / taylor | exact false / missed / wrong | taylor false / missed / wrong | "
+          "hessian false / missed / wrong | exact emit s | exact driver compile s |")
+    print("|---|---|" + "---|" * 10)
+    for name in names:
+        if name.isdigit():
+            surface, label = row_surface(rows[int(name)]), f"{rows[int(name)].name} ({name})"
+        else:
+            surface, label = load_surface(name), name
+        r = measure_sweep(surface, size, frames)
+        taylor = r["taylor", choose_form(surface.expr)]
+        exact = r["exact", "auto"]
+        counts = [f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
+                  for c in (exact, taylor, r["hessian", "auto"])]
+        print(f"| {label} | {polynomial_degree(surface.expr)} | "
+              + " | ".join(f"{r[k]['ms']:.1f}" for k in SWEEP_RUNS)
+              + f" | {exact['ms'] / taylor['ms']:.2f} | " + " | ".join(counts)
+              + f" | {exact['emit_s']:.2f} | {exact['driver_s']:.2f} |", flush=True)
+
+
 def _plot(rows, size: int, path: str) -> None:
     import matplotlib
 
@@ -180,7 +209,7 @@ def _plot(rows, size: int, path: str) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("mode", choices=("accuracy", "sweep"))
+    ap.add_argument("mode", choices=("accuracy", "sweep", "gallery"))
     ap.add_argument("surfaces", nargs="*")
     ap.add_argument("--size", type=int, default=512)
     ap.add_argument("--frames", type=int, default=3)
@@ -190,6 +219,8 @@ def main() -> None:
     args = ap.parse_intermixed_args()
     if args.mode == "accuracy":
         accuracy(args.surfaces, args.methods, args.size, args.frames)
+    elif args.mode == "gallery":
+        gallery(args.surfaces, args.size, args.frames)
     else:
         lo, hi = (int(v) for v in args.degrees.split("-"))
         sweep(list(range(lo, hi + 1)), args.size, args.frames, args.plot)
