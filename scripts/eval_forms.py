@@ -116,27 +116,36 @@ def measure_sweep(surface, size: int, frames: int) -> dict:
                                                first_use, strict=True)}
 
 
+_HEADER = ("exact ms | taylor point ms | taylor ray-poly ms | hessian ms | exact / taylor | "
+           "exact false / missed / wrong | taylor false / missed / wrong | "
+           "hessian false / missed / wrong | exact emit s | exact driver compile s |")
+
+
+def _measured_row(first: str, surface, size: int, frames: int) -> tuple[dict, float]:
+    """Measure `surface` (measure_sweep), print its table row after the cells `first`,
+    and return the measurements and exact / taylor (the form `--eval auto` picks)."""
+    r = measure_sweep(surface, size, frames)
+    taylor = r["taylor", choose_form(surface.expr)]
+    exact = r["exact", "auto"]
+    counts = [f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
+              for c in (exact, taylor, r["hessian", "auto"])]
+    print(f"| {first} | " + " | ".join(f"{r[k]['ms']:.1f}" for k in SWEEP_RUNS)
+          + f" | {exact['ms'] / taylor['ms']:.2f} | " + " | ".join(counts)
+          + f" | {exact['emit_s']:.2f} | {exact['driver_s']:.2f} |", flush=True)
+    return r, exact["ms"] / taylor["ms"]
+
+
 def sweep(degrees: list[int], size: int, frames: int, plot: str | None) -> None:
     """The degree sweep (docs/RESULTS.md): exact against taylor (b = 0.01, both forms;
     `taylor` in the ratio is the form `auto` picks) and hessian, per family and degree."""
     rows = []
-    print("| family | degree | exact ms | taylor point ms | taylor ray-poly ms | hessian ms | "
-          "exact / taylor | exact false / missed / wrong | taylor false / missed / wrong | "
-          "hessian false / missed / wrong | exact emit s | exact driver compile s |")
+    print(f"| family | degree | {_HEADER}")
     print("|---|---|" + "---|" * 10)
     for degree in degrees:
         for family, equation in sweep_equations(degree).items():
             surface = load_surface(equation=equation)
-            r = measure_sweep(surface, size, frames)
-            taylor = r["taylor", choose_form(surface.expr)]
-            exact = r["exact", "auto"]
-            rows.append((family, degree, r, exact["ms"] / taylor["ms"]))
-            counts = [f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
-                      for c in (exact, taylor, r["hessian", "auto"])]
-            print(f"| {family} | {degree} | "
-                  + " | ".join(f"{r[k]['ms']:.1f}" for k in SWEEP_RUNS)
-                  + f" | {exact['ms'] / taylor['ms']:.2f} | " + " | ".join(counts)
-                  + f" | {exact['emit_s']:.2f} | {exact['driver_s']:.2f} |", flush=True)
+            r, ratio = _measured_row(f"{family} | {degree}", surface, size, frames)
+            rows.append((family, degree, r, ratio))
     if plot:
         _plot(rows, size, plot)
 
@@ -148,24 +157,14 @@ def gallery(names: list[str], size: int, frames: int) -> None:
 
     rows = {r.number: r for r in load_rows(default_tsv())} if any(
         n.isdigit() for n in names) else {}
-    print("| surface | degree | exact ms | taylor point ms | taylor ray-poly ms | hessian ms | "
-          "exact / taylor | exact false / missed / wrong | taylor false / missed / wrong | "
-          "hessian false / missed / wrong | exact emit s | exact driver compile s |")
+    print(f"| surface | degree | {_HEADER}")
     print("|---|---|" + "---|" * 10)
     for name in names:
         if name.isdigit():
             surface, label = row_surface(rows[int(name)]), f"{rows[int(name)].name} ({name})"
         else:
             surface, label = load_surface(name), name
-        r = measure_sweep(surface, size, frames)
-        taylor = r["taylor", choose_form(surface.expr)]
-        exact = r["exact", "auto"]
-        counts = [f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
-                  for c in (exact, taylor, r["hessian", "auto"])]
-        print(f"| {label} | {polynomial_degree(surface.expr)} | "
-              + " | ".join(f"{r[k]['ms']:.1f}" for k in SWEEP_RUNS)
-              + f" | {exact['ms'] / taylor['ms']:.2f} | " + " | ".join(counts)
-              + f" | {exact['emit_s']:.2f} | {exact['driver_s']:.2f} |", flush=True)
+        _measured_row(f"{label} | {polynomial_degree(surface.expr)}", surface, size, frames)
 
 
 def _plot(rows, size: int, path: str) -> None:
