@@ -19,6 +19,7 @@ import argparse
 import os
 import statistics
 import time
+from pathlib import Path
 
 os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "true")  # compile times are cold
 
@@ -150,6 +151,20 @@ def sweep(degrees: list[int], size: int, frames: int, plot: str | None) -> None:
         _plot(rows, size, plot)
 
 
+def rows_from_table(path: str) -> list:
+    """The sweep's rows back from its printed table (to redraw the plot unmeasured)."""
+    rows = []
+    for line in Path(path).read_text(encoding="utf-8").splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 12 or not cells[1].isdigit():
+            continue
+        ms = [float(c) for c in cells[2:6]]
+        r = {key: {"ms": m} for key, m in zip(SWEEP_RUNS, ms, strict=True)}
+        r["exact", "auto"].update(emit_s=float(cells[10]), driver_s=float(cells[11]))
+        rows.append((cells[0], int(cells[1]), r, float(cells[6])))
+    return rows
+
+
 def gallery(names: list[str], size: int, frames: int) -> None:
     """The sweep's measurement on named surfaces: bundled examples, or corpus rows by
     number (the parameters as `implc corpus` gives them)."""
@@ -215,12 +230,17 @@ def main() -> None:
     ap.add_argument("--methods", nargs="+", default=["taylor", "hessian"])
     ap.add_argument("--degrees", default="2-20")
     ap.add_argument("--plot")
+    ap.add_argument("--from-table", help="sweep: redraw --plot from this printed table "
+                    "instead of measuring")
     args = ap.parse_intermixed_args()
     if args.mode == "accuracy":
         accuracy(args.surfaces, args.methods, args.size, args.frames)
     elif args.mode == "gallery":
         gallery(args.surfaces, args.size, args.frames)
     else:
+        if args.from_table:
+            _plot(rows_from_table(args.from_table), args.size, args.plot)
+            return
         lo, hi = (int(v) for v in args.degrees.split("-"))
         sweep(list(range(lo, hi + 1)), args.size, args.frames, args.plot)
 
