@@ -28,15 +28,19 @@ from .raypoly import (
 # From this degree the exact method isolates F's first root by Bernstein subdivision
 # (Descartes' rule of signs on the Bernstein coefficients of a node, stackless: the next
 # node follows from the current one) instead of the critical points level by level: it
-# visits 3-6 nodes a ray and stops at the first root, where the levels find every root
-# of every derivative. Measured at 512^2 (docs/RESULTS.md section 7): level by level
-# against Bernstein, 19.2 / 19.7 ms at degree 6, 32.2 / 24.0 at 7, 46.6 / 32.8 at 8, 97 /
-# 13-18 at 12.
+# visits 2-6 nodes a ray and stops at the first root, where the levels find every root
+# of every derivative. Measured (docs/RESULTS.md section 8): Bernstein is 1.1-2x faster
+# from degree 5 on, but loses first roots that graze the surface where F dips below the
+# rounding of a node's coefficients (the heart, degree 6: 751 wrong-root pixels of 262,144
+# against the levels' 13; the Cross-Cap, degree 4: 25 missed against 0), and the levels
+# are faster at degrees 2-4.
 BERNSTEIN_FROM = 7
 
-# The exact method's highest degree. Float32 root isolation loses accuracy with the
-# degree; measured at 512^2 (issue 21's note): 12 bad pixels of 262,144 at degree 14 and
-# 17 at 18, against 0-3 at 10-12 (the limit there is the float32 ray coefficients).
+# The exact method's highest degree. Float32 root isolation through the expanded ray
+# polynomial loses accuracy with the degree and the coefficients' size; measured at 512^2
+# (docs/RESULTS.md section 8): 9 bad pixels of 262,144 on the degree-14 knot and 3 on the
+# degree-18 one, 0-5 on the gallery rows of degree 10-12, but thousands on Chmutov's
+# surfaces from degree 13 (coefficients up to 2^(n-1), where every method fails).
 EXACT_MAX_DEGREE = 20
 
 
