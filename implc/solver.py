@@ -36,6 +36,12 @@ from .raypoly import (
 # are faster at degrees 2-4.
 BERNSTEIN_FROM = 7
 
+# Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its
+# middle is a touching root when |F| there is within TOUCH), and a ray visits at most 96
+# nodes (measured: 2-6 on average, 34 at most on Barth's decic at 256^2).
+BERNSTEIN_DEPTH = 14
+BERNSTEIN_MAX_NODES = 96
+
 # The exact method's highest degree. Float32 root isolation through the expanded ray
 # polynomial loses accuracy with the degree and the coefficients' size; measured at 512^2
 # (docs/RESULTS.md section 8): 9 bad pixels of 262,144 on the degree-14 knot and 3 on the
@@ -85,7 +91,7 @@ class Solver:
     depth: int = 0
     # bernstein: w_i = -1 + 2i/n (printed), where b_i sits in the node's control polygon,
     # whose zero starts the Newton (see lower_solver)
-    nodes: tuple[str, ...] = ()
+    control_w: tuple[str, ...] = ()
 
 
 def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
@@ -112,8 +118,6 @@ def _value_function(name: str, n: int, printer, prefix: str,
         (*printed_lets(powers, printer), ("real", "h", printer.doprint(value))),
         (printer.print_select(certain, "h", at_point),))
 
-
-# --- the exact method: root isolation on the ray polynomial ------------------------------
 
 def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                   max_derived: int, carried: tuple[tuple[str, str], ...]) -> Marcher:
@@ -161,13 +165,13 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     empty = Code((), ())
     solver = Solver(n, bottom, closed)
     if bernstein:
-        coefficients = bernstein_lets(n, printer)
         # Newton starts at the zero of the root node's control polygon (the points
         # (w_i, b_i)), not at the secant of its ends: at degree 18 F is far steeper at one
         # end than near the root, and the secant starts next to the other end. Measured on
         # x^18 + y^18 + z^18 = 1 at 512^2: 6.3 -> 4.5 Newton steps a hit pixel, 7 % a frame.
-        nodes = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
-        solver = Solver(n, bottom, closed, "bernstein", coefficients, BERNSTEIN_DEPTH, nodes)
+        control_w = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
+        solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
+                        BERNSTEIN_DEPTH, control_w)
         value, powers = estrin(c, u)
         functions.append(ShaderFunction(
             "Fh", "F at u by Estrin's scheme alone: the Newton loop's value, inside a bracket "
@@ -204,10 +208,3 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str], ...]:
         lets += [(f"be{i}", printer.doprint(even)), (f"bo{i}", printer.doprint(odd)),
                  (f"b{i}", f"be{i} + bo{i}"), (f"b{n - i}", f"be{i} - bo{i}")]
     return tuple(lets)
-
-
-# Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its
-# middle is a touching root when |F| there is within TOUCH), and a ray visits at most 96
-# nodes (measured: 3-6 on average, 34 at most on Barth's decic at 256^2).
-BERNSTEIN_DEPTH = 14
-BERNSTEIN_MAX_NODES = 96
