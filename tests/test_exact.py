@@ -206,7 +206,10 @@ def test_bernstein_solver_holds_at_degree_14(backend):
     from implc.corpus import default_tsv, load_rows, row_surface
 
     require_backend(backend)
-    row = next(r for r in load_rows(default_tsv()) if r.number == 247)
+    tsv = default_tsv()
+    if tsv is None:  # the knot is GPL-2 (mathmod): it stays in ../shared, not in this repo
+        pytest.skip("../shared/corpus is not present (a fresh clone)")
+    row = next(r for r in load_rows(tsv) if r.number == 247)
     surface = row_surface(row)
     assert polynomial_degree(surface.expr) == 14
     size = 128
