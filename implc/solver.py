@@ -1,6 +1,6 @@
 """The `exact` method: root isolation on the ray polynomial, lowered to the pieces of
-templates/solver.j2 (critical points level by level up to degree 6, Bernstein subdivision
-with Descartes' rule of signs from degree 7; see BERNSTEIN_FROM), and the rule that makes
+templates/solver.j2 (critical points level by level up to degree 4, Bernstein subdivision
+with Descartes' rule of signs from degree 5; see BERNSTEIN_FROM), and the rule that makes
 it the default method."""
 
 from __future__ import annotations
@@ -29,12 +29,21 @@ from .raypoly import (
 # (Descartes' rule of signs on the Bernstein coefficients of a node, stackless: the next
 # node follows from the current one) instead of the critical points level by level: it
 # visits 2-6 nodes a ray and stops at the first root, where the levels find every root
-# of every derivative. Measured (docs/RESULTS.md section 8): Bernstein is 1.1-2x faster
-# from degree 5 on, but loses first roots that graze the surface where F dips below the
-# rounding of a node's coefficients (the heart, degree 6: 751 wrong-root pixels of 262,144
-# against the levels' 13; the Cross-Cap, degree 4: 25 missed against 0), and the levels
-# are faster at degrees 2-4.
-BERNSTEIN_FROM = 7
+# of every derivative. Measured at 512^2 (docs/RESULTS.md section 8), exact / taylor:
+# degree 5-6 with the levels 0.84-1.03 (Taubin's heart, Barth's sextic, x^6 + y^6 + z^6),
+# with Bernstein 0.41-0.46 and no more bad pixels (the heart 10 of 262,144 against the
+# levels' 15) since each node's ends are F's robust values (see templates/solver.j2); at
+# degree 4 the levels stay faster (Cross-Cap 0.43 against 0.48) and exact (Bernstein
+# misses 15 pixels where the Cross-Cap's sheets meet).
+BERNSTEIN_FROM = 5
+
+# Below this degree the Newton after the Bernstein walk takes F's robust value (P_n: S at
+# the point where Estrin's sign is uncertain), from it Estrin's value of the chord's
+# coefficients alone. Measured at 512^2: on Taubin's heart (degree 6, roots as flat as
+# F ~ 1e-9 over 1e-2 of the ray) Estrin's value alone put 293 roots 1e-3 or more from
+# their place, the robust one 8, and Barth's sextic ran faster with it (0.44 against
+# 0.54 of taylor); at degree 9 (corpus row 163) it cost 15 % a frame for 1 pixel.
+ROBUST_NEWTON_BELOW = 7
 
 # Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its
 # middle is a touching root when |F| there is within TOUCH), and a ray visits at most 96
@@ -92,6 +101,8 @@ class Solver:
     # bernstein: w_i = -1 + 2i/n (printed), where b_i sits in the node's control polygon,
     # whose zero starts the Newton (see lower_solver)
     control_w: tuple[str, ...] = ()
+    # bernstein: the Newton after the walk takes F's robust value (ROBUST_NEWTON_BELOW)
+    robust_newton: bool = False
 
 
 def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
@@ -171,7 +182,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         # x^18 + y^18 + z^18 = 1 at 512^2: 6.3 -> 4.5 Newton steps a hit pixel, 7 % a frame.
         control_w = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
-                        BERNSTEIN_DEPTH, control_w)
+                        BERNSTEIN_DEPTH, control_w, n < ROBUST_NEWTON_BELOW)
         value, powers = estrin(c, u)
         functions.append(ShaderFunction(
             "Fh", "F at u by Estrin's scheme alone: the Newton loop's value, inside a bracket "
