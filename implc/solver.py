@@ -181,13 +181,15 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         # end than near the root, and the secant starts next to the other end. Measured on
         # x^18 + y^18 + z^18 = 1 at 512^2: 6.3 -> 4.5 Newton steps a hit pixel, 7 % a frame.
         control_w = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
+        robust_newton = n < ROBUST_NEWTON_BELOW
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
-                        BERNSTEIN_DEPTH, control_w, n < ROBUST_NEWTON_BELOW)
-        value, powers = estrin(c, u)
-        functions.append(ShaderFunction(
-            "Fh", "F at u by Estrin's scheme alone: the Newton loop's value, inside a bracket "
-            f"whose ends P{n} confirmed", (("Ray", "ray"), ("real", "u")), "real",
-            tuple(printed_lets(powers, printer)), (printer.doprint(value),)))
+                        BERNSTEIN_DEPTH, control_w, robust_newton)
+        if not robust_newton:
+            value, powers = estrin(c, u)
+            functions.append(ShaderFunction(
+                "Fh", "F at u by Estrin's scheme alone: the Newton loop's value, inside a "
+                f"bracket whose ends P{n} confirmed", (("Ray", "ray"), ("real", "u")), "real",
+                tuple(printed_lets(powers, printer)), (printer.doprint(value),)))
         printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
