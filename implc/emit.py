@@ -164,7 +164,7 @@ def emit(
         "params_struct_size": -(-(WGSL_PARAM_OFFSET + 4 * len(uniforms)) // 16) * 16,
         "method": meth.name,
         "method_label": label,
-        "form": form,
+        "form": marcher.form,
         "marcher": marcher,
         "lang": f"{tgt.name}/lang.j2",
         "T": types,

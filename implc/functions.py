@@ -9,9 +9,12 @@ language's printer (`known_functions` in implc/backends/<target>.py, sympy's idi
 a new target adds one dict instead of a column to every row.
 
 To add a function: add a row here (user name, arity, sympy constructor, the sympy class
-name it prints from, numpy implementation, a semantics note) and its spelling to every
-printer's `known_functions`. Rows with `user=False` are never written by users; they
-appear only in derivatives (e.g. d|x|/dx = sign(x)) and must still print on every target.
+name it prints from, numpy implementation, a semantics note, its interval rule and the
+shader's error bound that widens it) and its spelling to every printer's
+`known_functions`. Rows with `user=False` are never written by users; they appear only in
+derivatives (e.g. d|x|/dx = sign(x)) or in interval rules (floor) and must still print on
+every target. A row without an interval rule makes `-m interval` refuse a surface that
+uses it (implc/interval.py), never bound it unsoundly.
 """
 
 from __future__ import annotations
@@ -21,6 +24,16 @@ from dataclasses import dataclass
 
 import numpy as np
 import sympy
+from sympy import Max, Min, Piecewise, floor, pi
+
+# An interval rule: the argument's enclosure (lo, hi), as sympy symbols, and `let` (a value
+# -> a symbol naming it, for a value used twice) -> the function's enclosure over it
+# (lo', hi') and the condition under which the function is undefined on the whole
+# argument interval (F is then NaN there: no root; sympy.false if never).
+Bound = tuple[sympy.Expr, sympy.Expr, sympy.Basic]
+# The value an unbounded enclosure takes (a pole, log(0), 1/0): finite so that a later
+# product with 0 stays a number; anything it overflows to (inf, NaN) is never skipped.
+BIG = 1e30
 
 
 @dataclass(frozen=True)
@@ -34,31 +47,115 @@ class Function:
     numpy: Callable[..., np.ndarray]  # float64 CPU semantics, same as the shaders'
     note: str
     user: bool = True
+    # the interval rule (implc/interval.py), None: -m interval refuses the function
+    interval: Callable[..., Bound] | None = None
+    # how far a shader's value may lie from the exact one, widening the rule's bounds:
+    # (units of float32's epsilon relative to the value, absolute); see implc/interval.py
+    error: tuple[float, float] = (0.0, 0.0)
 
 
 def _heaviside(x, *_):
     return np.where(x > 0, 1.0, np.where(x < 0, 0.0, 0.5))
 
 
+def _increasing(f):
+    return lambda lo, hi, let: (f(lo), f(hi), sympy.false)
+
+
+def _on_domain(f, low, high=None, increasing=True):
+    """A monotonic function defined on [low, high]: the argument clamped into it; undefined
+    on the whole interval when it lies outside."""
+    def rule(lo, hi, let):
+        a = let(Max(lo, low, evaluate=False))
+        b = let(Max(hi, low, evaluate=False))
+        if high is not None:
+            a, b = let(Min(a, high, evaluate=False)), let(Min(b, high, evaluate=False))
+        dead = (hi < low) if high is None else sympy.Or(hi < low, lo > high)
+        return (f(a), f(b), dead) if increasing else (f(b), f(a), dead)
+    return rule
+
+
+def _periodic(f, peak):
+    """sin or cos: -1 or 1 where [lo, hi] holds a minimum or a maximum (maxima at
+    peak + 2 pi k, minima pi after them), else the ends' values. Measured from the last
+    maximum at or before lo: a in [0, 2 pi), b = a + (hi - lo). Float32's floor may put
+    k one off where lo is at an extremum, where f is flat: an error of second order,
+    inside the widening."""
+    def rule(lo, hi, let):
+        shifted = let(lo - _number(peak)) if peak else lo
+        a = let(shifted - _number(2 * pi) * floor(shifted * _number(1 / (2 * pi))))
+        b = let(a + (hi - lo))
+        ends = (let(f(lo)), let(f(hi)))
+        has_min = sympy.Or(sympy.And(a <= _number(pi), b >= _number(pi)), b >= _number(3 * pi))
+        low = Piecewise((-1, has_min), (Min(*ends, evaluate=False), True))
+        high = Piecewise((1, b >= _number(2 * pi)), (Max(*ends, evaluate=False), True))
+        return low, high, sympy.false
+    return rule
+
+
+def _number(value) -> sympy.Float:
+    """A constant as one literal (a printer prints 2*pi as a product)."""
+    return sympy.Float(float(value), 17)
+
+
+def _tan(lo, hi, let):
+    """tan: increasing between its poles at pi/2 + k pi; unbounded across one."""
+    same = sympy.Eq(floor(lo * _number(1 / pi) + sympy.S.Half),
+                    floor(hi * _number(1 / pi) + sympy.S.Half))
+    return (Piecewise((sympy.tan(lo), same), (-BIG, True)),
+            Piecewise((sympy.tan(hi), same), (BIG, True)), sympy.false)
+
+
+def _even(f):
+    """An even function increasing on [0, oo) (cosh): its least value at 0 when it is inside."""
+    def rule(lo, hi, let):
+        inner = let(Max(lo, -hi, 0, evaluate=False))  # the least |x| on [lo, hi]
+        return f(inner), Max(f(lo), f(hi), evaluate=False), sympy.false
+    return rule
+
+
+def _abs(lo, hi, let):
+    return Max(lo, -hi, 0, evaluate=False), Max(-lo, hi, evaluate=False), sympy.false
+
+
+def _log(lo, hi, let):
+    return (Piecewise((sympy.log(lo), lo > 0), (-BIG, True)),
+            Piecewise((sympy.log(hi), hi > 0), (-BIG, True)), hi <= 0)
+
+
 FUNCTIONS: tuple[Function, ...] = (
-    Function("sin", 1, sympy.sin, "sin", np.sin, "radians"),
-    Function("cos", 1, sympy.cos, "cos", np.cos, "radians"),
-    Function("tan", 1, sympy.tan, "tan", np.tan, "radians"),
-    Function("asin", 1, sympy.asin, "asin", np.arcsin, "domain [-1, 1]"),
-    Function("acos", 1, sympy.acos, "acos", np.arccos, "domain [-1, 1]"),
-    Function("atan", 1, sympy.atan, "atan", np.arctan, "range (-pi/2, pi/2)"),
+    Function("sin", 1, sympy.sin, "sin", np.sin, "radians",
+             interval=_periodic(sympy.sin, pi / 2), error=(8, 2.0**-21)),
+    Function("cos", 1, sympy.cos, "cos", np.cos, "radians",
+             interval=_periodic(sympy.cos, 0), error=(8, 2.0**-21)),
+    Function("tan", 1, sympy.tan, "tan", np.tan, "radians", interval=_tan, error=(16, 2.0**-21)),
+    Function("asin", 1, sympy.asin, "asin", np.arcsin, "domain [-1, 1]",
+             interval=_on_domain(sympy.asin, -1, 1), error=(16, 2.0**-21)),
+    Function("acos", 1, sympy.acos, "acos", np.arccos, "domain [-1, 1]",
+             interval=_on_domain(sympy.acos, -1, 1, increasing=False), error=(16, 2.0**-21)),
+    Function("atan", 1, sympy.atan, "atan", np.arctan, "range (-pi/2, pi/2)",
+             interval=_increasing(sympy.atan), error=(16, 2.0**-21)),
+    # atan2 has no interval rule (its branch cut): -m interval refuses it
     Function("atan2", 2, sympy.atan2, "atan2", np.arctan2, "atan2(y, x), angle of (x, y)"),
-    Function("sinh", 1, sympy.sinh, "sinh", np.sinh, ""),
-    Function("cosh", 1, sympy.cosh, "cosh", np.cosh, ""),
-    Function("tanh", 1, sympy.tanh, "tanh", np.tanh, ""),
-    Function("exp", 1, sympy.exp, "exp", np.exp, ""),
-    Function("log", 1, sympy.log, "log", np.log, "natural logarithm; x > 0"),
-    Function("sqrt", 1, sympy.sqrt, "sqrt", np.sqrt, "x >= 0; NaN (no surface) below"),
+    Function("sinh", 1, sympy.sinh, "sinh", np.sinh, "", interval=_increasing(sympy.sinh),
+             error=(16, 2.0**-21)),
+    Function("cosh", 1, sympy.cosh, "cosh", np.cosh, "", interval=_even(sympy.cosh),
+             error=(16, 0)),
+    Function("tanh", 1, sympy.tanh, "tanh", np.tanh, "", interval=_increasing(sympy.tanh),
+             error=(16, 2.0**-21)),
+    Function("exp", 1, sympy.exp, "exp", np.exp, "", interval=_increasing(sympy.exp),
+             error=(16, 0)),
+    Function("log", 1, sympy.log, "log", np.log, "natural logarithm; x > 0", interval=_log,
+             error=(16, 2.0**-21)),
+    Function("sqrt", 1, sympy.sqrt, "sqrt", np.sqrt, "x >= 0; NaN (no surface) below",
+             interval=_on_domain(sympy.sqrt, 0), error=(4, 0)),
     # Sugar: builds sign(a)*|a|^(1/3) from other rows, so no node of its own reaches a printer.
     Function("cbrt", 1, lambda a: sympy.sign(a) * sympy.Abs(a) ** sympy.Rational(1, 3), None,
              np.cbrt, "real cube root, defined for negative x (same as x^(1/3))"),
-    Function("abs", 1, sympy.Abs, "Abs", np.abs, "derivative sign(x)"),
-    Function("sign", 1, sympy.sign, "sign", np.sign, "-1, 0 or 1; derivative 0"),
+    Function("abs", 1, sympy.Abs, "Abs", np.abs, "derivative sign(x)", interval=_abs),
+    Function("sign", 1, sympy.sign, "sign", np.sign, "-1, 0 or 1; derivative 0",
+             interval=lambda lo, hi, let: (sympy.sign(lo), sympy.sign(hi), sympy.false)),
+    # min and max take their arguments' bounds apart (implc/interval.py)
     Function("min", 2, sympy.Min, "Min", np.minimum, "smooth union in CSG; derivative by branch"),
     Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch"),
     # Only in derivatives: the step of min/max/abs and the (ignored) spike of sign.
@@ -66,6 +163,8 @@ FUNCTIONS: tuple[Function, ...] = (
              "derivative of min/max; 1 for x > 0, 0 for x < 0", user=False),
     Function("delta", 1, sympy.DiracDelta, "DiracDelta", lambda x, *_: np.zeros_like(x),
              "derivative of sign(x); taken as 0 (almost everywhere)", user=False),
+    # Only in interval rules (sin, cos, tan: which period an end lies in).
+    Function("floor", 1, sympy.floor, "floor", np.floor, "largest integer <= x", user=False),
 )
 
 USER_FUNCTIONS: dict[str, Function] = {f.name: f for f in FUNCTIONS if f.user}

@@ -25,6 +25,7 @@ import sympy
 
 from .derive import polynomial_degree
 from .errors import InputError
+from .interval import range_constants, range_function
 from .methods import (
     CONSTANT_SYMBOLS,
     D0,
@@ -162,6 +163,8 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
         return lower_solver(constants, expr, printer, prefix, max_derived, carried)
     const_names = {c: sympy.Symbol(prefix.upper() + c.name, real=True)
                    for c in CONSTANT_SYMBOLS}
+    if method.bounds:  # F's enclosure over a segment works on S's tree, at points
+        form = "point"
 
     def show(expr: sympy.Basic) -> str:
         return printer.doprint(expr.xreplace(const_names))
@@ -232,8 +235,11 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
                     for c in CONSTANT_SYMBOLS if c in used)
     printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),
                 ("int", prefix.upper() + "REFINE_STEPS", str(int(constants.refine_steps))))
+    if method.bounds:
+        functions.append(range_function(expr, printer, prefix, carried))
+        printed = range_constants(printer, prefix) + printed[-1:]  # and REFINE_STEPS
     return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root,
-                   carried=carried)
+                   interval=method.bounds, carried=carried)
 
 
 def _apply(quantity: str, arg: sympy.Expr) -> sympy.Expr:

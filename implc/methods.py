@@ -198,6 +198,9 @@ class Method:
     defaults: Constants = field(default_factory=Constants)
     paper_column: str = ""  # the column of the paper's Table 1 it reproduces ("" if none)
     solves: bool = False  # exact: polynomial surfaces only
+    # interval: no step rule or root test; F's enclosure over a segment decides
+    # (implc/interval.py, templates/interval.j2)
+    bounds: bool = False
 
     @property
     def reads_taylor2(self) -> bool:
@@ -241,6 +244,10 @@ METHODS: dict[str, Method] = {
         Method("exact", "polynomial S: the first real root of the ray polynomial, isolated "
                "exactly (monotonic pieces between critical points; no marching)",
                solves=True),
+        # F and F' are sampled for the refinement only
+        Method("interval", "any S: segments where F's interval enclosure excludes 0 are "
+               "skipped, the others halved down to the leaf, where F's sign change is "
+               "refined (no sign change missed)", (F(S), DF(S), sympy.S.Zero), bounds=True),
     )
 }
 

@@ -50,6 +50,23 @@ def _eval(node, env, cache):
             value = value * _eval(a, env, cache)
     elif node.is_Pow:
         value = _pow(_eval(node.base, env, cache), node.exp, env, cache)
+    elif isinstance(node, sympy.Piecewise):  # interval rules (implc/interval.py)
+        value = _eval(node.args[-1].expr, env, cache)
+        for branch in reversed(node.args[:-1]):
+            value = np.where(_eval(branch.cond, env, cache), _eval(branch.expr, env, cache),
+                             value)
+    elif node.is_Relational:
+        value = _RELATIONS[node.rel_op](_eval(node.lhs, env, cache), _eval(node.rhs, env, cache))
+    elif isinstance(node, (sympy.And, sympy.Or)):
+        parts = [_eval(a, env, cache) for a in node.args]
+        combine = np.logical_and if isinstance(node, sympy.And) else np.logical_or
+        value = parts[0]
+        for part in parts[1:]:
+            value = combine(value, part)
+    elif isinstance(node, sympy.Not):
+        value = np.logical_not(_eval(node.args[0], env, cache))
+    elif node in (sympy.true, sympy.false):
+        value = np.bool_(node is sympy.true)
     else:
         name = type(node).__name__
         row = BY_SYMPY_NAME.get(name)
@@ -64,6 +81,10 @@ def _eval(node, env, cache):
             value = row.numpy(*args)
     cache[node] = value
     return value
+
+
+_RELATIONS = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal,
+              "==": np.equal, "!=": np.not_equal}
 
 
 def _pow(base, exp, env, cache):

@@ -66,6 +66,7 @@ class Marcher:
     step: Code
     root: Code
     solver: Solver | None = None
+    interval: bool = False  # the interval march (templates/interval.j2)
     carried: tuple[tuple[str, str], ...] = ()  # see `lower`
 
     @property

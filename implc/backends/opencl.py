@@ -26,6 +26,7 @@ known_functions = {
     "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
     "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "exp": "exp",
     "log": "log", "sqrt": "sqrt", "Abs": "fabs", "sign": "sign", "Min": "fmin", "Max": "fmax",
+    "floor": "floor",
 }
 
 
