@@ -43,7 +43,7 @@ from .symbols import POINT
 # at most TOUCH), and a ray visits at most MAX_NODES nodes.
 DEPTH = 16
 MAX_NODES = 1024
-TOUCH = 1e-6
+TOUCH = 1e-7
 
 # The segment [A, B] of the ray o + s d, |d| = 1: the inputs the printed program reads
 # (names as the shader spells them, fields of the ray record).

@@ -13,14 +13,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import jinja2
 import numpy as np
 import pytest
 from cases import EXAMPLES, PAPER
 from conftest import require_backend, require_gl, require_tool
+from gl_rays import intersect
 
 from implc.derive import polynomial_degree
-from implc.emit import emit, render_template
+from implc.emit import emit
 from implc.errors import InputError
 from implc.methods import METHODS
 from implc.metrics import compare
@@ -47,30 +47,8 @@ def test_exact_matches_the_reference(example):
 
 
 def _rays(example: str, rays: list[tuple]) -> np.ndarray:
-    """(hit, t) of each (ro, rd, t0, t1) through the library's intersect."""
-    import moderngl
-
-    from implc.render.gl import context
-
-    library = emit(load_surface(example), "glsl", "exact", None, "330", "library", "x_")
-    env = jinja2.Environment(loader=jinja2.FileSystemLoader(str(DATA)),
-                             undefined=jinja2.StrictUndefined)
-    fragment = env.get_template("rays.frag.j2").render(count=len(rays), library=library,
-                                                        prefix="x_")
-    vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
-    ctx = context()
-    program = ctx.program(vertex_shader=vertex, fragment_shader=fragment)
-    program["u_ro"].value = [r[0] for r in rays]
-    program["u_rd"].value = [tuple(np.asarray(r[1]) / np.linalg.norm(r[1])) for r in rays]
-    program["u_span"].value = [(r[2], r[3]) for r in rays]
-    out = ctx.texture((len(rays), 1), 4, dtype="f4")
-    aux = ctx.texture((len(rays), 1), 4, dtype="f4")
-    fbo = ctx.framebuffer(color_attachments=[out, aux])
-    fbo.use()
-    fbo.viewport = (0, 0, len(rays), 1)
-    ctx.vertex_array(program, []).render(mode=moderngl.TRIANGLES, vertices=3)
-    data = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32).reshape(-1, 4)
-    return data[:, :2]
+    """(hit, t) of each (ro, rd, t0, t1) through the exact library's intersect."""
+    return intersect(load_surface(example), "exact", rays)
 
 
 def test_tangent_rays_touch_and_near_misses_miss():
