@@ -160,7 +160,9 @@ FUNCTIONS: tuple[Function, ...] = (
     Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch"),
     # Only in derivatives: the step of min/max/abs and the (ignored) spike of sign.
     Function("step", 1, sympy.Heaviside, "Heaviside", _heaviside,
-             "derivative of min/max; 1 for x > 0, 0 for x < 0", user=False),
+             "derivative of min/max; 1 for x > 0, 0 for x < 0", user=False,
+             interval=lambda lo, hi, let: (sympy.Heaviside(lo), sympy.Heaviside(hi),
+                                           sympy.false)),
     Function("delta", 1, sympy.DiracDelta, "DiracDelta", lambda x, *_: np.zeros_like(x),
              "derivative of sign(x); taken as 0 (almost everywhere)", user=False),
     # Only in interval rules (sin, cos, tan: which period an end lies in).

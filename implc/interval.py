@@ -36,6 +36,7 @@ from sympy import Abs, Max, Min, Piecewise
 from .errors import InputError
 from .functions import BIG, BY_SYMPY_NAME
 from .pieces import ShaderFunction, sym
+from .symbols import DIRECTION as DIRECTION_SYMBOLS
 from .symbols import POINT
 
 # The march's bounds: a node no wider than 2^-DEPTH of the chord is a leaf (a sign change of
@@ -135,6 +136,9 @@ class _Builder:
             # (the products' and the sum's roundings: two units)
             return self.widened(o + Min(*ends, evaluate=False), o + Max(*ends, evaluate=False),
                                 2)
+        if node in DIRECTION_SYMBOLS:  # (in F' = grad S . d) the ray's direction
+            d = DIRECTION[DIRECTION_SYMBOLS.index(node)]
+            return d, d
         if node.is_Symbol:  # a parameter read at run time: one value
             return node, node
         if node.is_Add:
@@ -235,18 +239,32 @@ class _Builder:
         return self.widened(lo, hi, ulps, absolute)
 
 
-def range_function(expr: sympy.Expr, printer, prefix: str,
+def derivative_program(expr: sympy.Expr) -> RangeProgram | None:
+    """F' = grad S . d enclosed over a segment, or None where F may jump (sign's
+    derivative is a delta, which has no interval rule): the march's monotonic test then
+    does not apply."""
+    from .derive import Derivatives
+
+    directional = Derivatives(expr, 10**9).quantity("dS")[0]
+    try:
+        return range_program(directional)
+    except InputError:
+        return None
+
+
+def range_function(name: str, program: RangeProgram, printer, prefix: str,
                    carried: tuple[tuple[str, str], ...] = ()) -> ShaderFunction:
-    """`F_range(ray, a, b)`: F's enclosure over [a, b] as (lo, hi), printed."""
-    program = range_program(expr)
+    """`F_range(ray, a, b)` (or `DF_range`, F''s): the enclosure over [a, b] as (lo, hi),
+    printed."""
     names = {ULP: sym(prefix.upper() + "IV_ULP"), TINY: sym(prefix.upper() + "IV_TINY")}
     lets = tuple(("real", name.name, printer.doprint(value.xreplace(names)))
                  for name, value in program.assignments)
     outputs = (printer.doprint(program.lo.xreplace(names)),
                printer.doprint(program.hi.xreplace(names)))
     params = (("Ray", "ray"), ("real", "a"), ("real", "b")) + carried
-    return ShaderFunction("F_range", "F's enclosure [lo, hi] over the ray segment s in [a, b] "
-                          "(interval arithmetic on S's tree, widened outward)", params,
+    what = "F'" if name.startswith("D") else "F"
+    return ShaderFunction(name, f"{what}'s enclosure [lo, hi] over the ray segment s in "
+                          "[a, b] (interval arithmetic on its tree, widened outward)", params,
                           "vec2", lets, outputs)
 
 

@@ -25,7 +25,7 @@ import sympy
 
 from .derive import polynomial_degree
 from .errors import InputError
-from .interval import range_constants, range_function
+from .interval import derivative_program, range_constants, range_function, range_program
 from .methods import (
     CONSTANT_SYMBOLS,
     D0,
@@ -235,11 +235,17 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
                     for c in CONSTANT_SYMBOLS if c in used)
     printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),
                 ("int", prefix.upper() + "REFINE_STEPS", str(int(constants.refine_steps))))
+    monotone = False
     if method.bounds:
-        functions.append(range_function(expr, printer, prefix, carried))
+        functions.append(range_function("F_range", range_program(expr), printer, prefix,
+                                        carried))
+        derivative = derivative_program(expr)
+        if derivative is not None:
+            functions.append(range_function("DF_range", derivative, printer, prefix, carried))
+            monotone = True
         printed = range_constants(printer, prefix) + printed[-1:]  # and REFINE_STEPS
     return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root,
-                   interval=method.bounds, carried=carried)
+                   interval=method.bounds, monotone=monotone, carried=carried)
 
 
 def _apply(quantity: str, arg: sympy.Expr) -> sympy.Expr:

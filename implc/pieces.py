@@ -67,6 +67,7 @@ class Marcher:
     root: Code
     solver: Solver | None = None
     interval: bool = False  # the interval march (templates/interval.j2)
+    monotone: bool = False  # interval: with F''s enclosure (DF_range), a monotonic test
     carried: tuple[tuple[str, str], ...] = ()  # see `lower`
 
     @property

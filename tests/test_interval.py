@@ -24,7 +24,7 @@ from gl_rays import intersect
 from implc.cli import main
 from implc.derive import polynomial_degree
 from implc.errors import InputError
-from implc.interval import A, B, DIRECTION, ORIGIN, TINY, ULP, WIDENING, range_program
+from implc.interval import DIRECTION, ORIGIN, TINY, ULP, WIDENING, A, B, range_program
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.numeric import evaluate, evaluate_program
