@@ -187,8 +187,9 @@ def render_template(name: str, **context) -> str:
 
 def _types(tgt, precision: str, prefix: str) -> dict:
     """The skeleton's abstract type names -> the target's spelling."""
-    real, vec2, vec3 = (t.replace("float", precision) for t in tgt.vector_types)
-    return {"real": real, "vec2": vec2, "vec3": vec3, "int": tgt.int_type, "bool": "bool",
+    real, vec2, vec3, vec4 = (t.replace("float", precision) for t in tgt.vector_types)
+    return {"real": real, "vec2": vec2, "vec3": vec3, "vec4": vec4, "int": tgt.int_type,
+            "bool": "bool",
             "Ray": prefix + "Ray", "Hit": prefix + "Hit", "Params": prefix + "Params"}
 
 

@@ -59,13 +59,20 @@ WIDENING = {"float": (2.0**-22, 2.0**-126), "double": (2.0**-51, 2.0**-1022)}
 
 @dataclass(frozen=True)
 class RangeProgram:
-    """Lets (symbol, value) in order, then F's enclosure (lo, hi) over [A, B]; a segment
-    where F is undefined throughout (the square root of a negative interval, ...) gets
-    [1, 1], which the march skips."""
+    """Lets (symbol, value) in order, then the enclosure (lo, hi) over [A, B] of each
+    expression asked for, F's first; a segment where F is undefined throughout (the square
+    root of a negative interval, ...) gets [1, 1], which the march skips."""
 
     assignments: tuple[tuple[sympy.Symbol, sympy.Basic], ...]
-    lo: sympy.Expr
-    hi: sympy.Expr
+    bounds: tuple[tuple[sympy.Expr, sympy.Expr], ...]
+
+    @property
+    def lo(self) -> sympy.Expr:
+        return self.bounds[0][0]
+
+    @property
+    def hi(self) -> sympy.Expr:
+        return self.bounds[0][1]
 
 
 def check_interval(expr: sympy.Expr) -> None:
@@ -73,23 +80,20 @@ def check_interval(expr: sympy.Expr) -> None:
     range_program(expr)
 
 
-def range_program(expr: sympy.Expr) -> RangeProgram:
-    """F's enclosure over a ray segment, from the tree of `expr` (see the module's doc)."""
-    return _cached(expr)
-
-
-_CACHE: dict[sympy.Expr, RangeProgram] = {}
-
-
-def _cached(expr: sympy.Expr) -> RangeProgram:
-    if expr not in _CACHE:
+def range_program(*exprs: sympy.Expr) -> RangeProgram:
+    """The enclosures of `exprs` over a ray segment, jointly (a subexpression they share
+    is enclosed once), from their trees (see the module's doc)."""
+    if exprs not in _CACHE:
         builder = _Builder()
-        lo, hi = builder.bound(expr)
+        bounds = [builder.bound(e) for e in exprs]
         dead = sympy.Or(*builder.dead) if builder.dead else sympy.false
         if dead is not sympy.false:
-            lo, hi = (Piecewise((1, dead), (v, True)) for v in (lo, hi))
-        _CACHE[expr] = RangeProgram(tuple(builder.lets), lo, hi)
-    return _CACHE[expr]
+            bounds = [tuple(Piecewise((1, dead), (v, True)) for v in pair) for pair in bounds]
+        _CACHE[exprs] = RangeProgram(tuple(builder.lets), tuple(bounds))
+    return _CACHE[exprs]
+
+
+_CACHE: dict[tuple[sympy.Expr, ...], RangeProgram] = {}
 
 
 class _Builder:
@@ -240,14 +244,14 @@ class _Builder:
 
 
 def derivative_program(expr: sympy.Expr) -> RangeProgram | None:
-    """F' = grad S . d enclosed over a segment, or None where F may jump (sign's
-    derivative is a delta, which has no interval rule): the march's monotonic test then
-    does not apply."""
+    """F and F' = grad S . d enclosed jointly over a segment, or None where F may jump
+    (sign's derivative is a delta, which has no interval rule): the march's monotonic test
+    then does not apply."""
     from .derive import Derivatives
 
     directional = Derivatives(expr, 10**9).quantity("dS")[0]
     try:
-        return range_program(directional)
+        return range_program(expr, directional)
     except InputError:
         return None
 
@@ -259,13 +263,14 @@ def range_function(name: str, program: RangeProgram, printer, prefix: str,
     names = {ULP: sym(prefix.upper() + "IV_ULP"), TINY: sym(prefix.upper() + "IV_TINY")}
     lets = tuple(("real", name.name, printer.doprint(value.xreplace(names)))
                  for name, value in program.assignments)
-    outputs = (printer.doprint(program.lo.xreplace(names)),
-               printer.doprint(program.hi.xreplace(names)))
+    outputs = tuple(printer.doprint(v.xreplace(names)) for pair in program.bounds
+                    for v in pair)
     params = (("Ray", "ray"), ("real", "a"), ("real", "b")) + carried
-    what = "F'" if name.startswith("D") else "F"
-    return ShaderFunction(name, f"{what}'s enclosure [lo, hi] over the ray segment s in "
-                          "[a, b] (interval arithmetic on its tree, widened outward)", params,
-                          "vec2", lets, outputs)
+    what = "F's and F''s enclosures (lo, hi, lo', hi')" if len(outputs) == 4 else \
+        "F's enclosure (lo, hi)"
+    return ShaderFunction(name, f"{what} over the ray segment s in [a, b] (interval "
+                          "arithmetic on the tree, widened outward)", params,
+                          "vec4" if len(outputs) == 4 else "vec2", lets, outputs)
 
 
 def range_constants(printer, prefix: str) -> tuple[tuple[str, str, str], ...]:

@@ -241,7 +241,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
                                         carried))
         derivative = derivative_program(expr)
         if derivative is not None:
-            functions.append(range_function("DF_range", derivative, printer, prefix, carried))
+            functions[-1] = range_function("FD_range", derivative, printer, prefix, carried)
             monotone = True
         printed = range_constants(printer, prefix) + printed[-1:]  # and REFINE_STEPS
     return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root,

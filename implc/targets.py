@@ -57,7 +57,7 @@ class Target:
     flavors: Mapping[str, Mapping[str, object]] = field(default_factory=lambda: {"default": {}})
     default_flavor: str = "default"
     precisions: tuple[str, ...] = ("float",)
-    vector_types: tuple[str, str, str] = ("float", "vec2", "vec3")  # templates' `types`
+    vector_types: tuple[str, ...] = ("float", "vec2", "vec3", "vec4")  # templates' `types`
     int_type: str = "int"  # the marcher's loop counters and step counts
     # how the functions of a `--params uniform` shader read the parameters: "global"
     # (uniforms, a uniform struct) or "argument" (a Params struct that every function
@@ -85,7 +85,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         validator="implc.validate:validate_wgsl",
         backends={"wgpu": Backend("implc.render.wgpu_runner:open_wgpu_runner",
                                   "WGSL compute shader on wgpu (Vulkan; lavapipe here)")},
-        vector_types=("f32", "vec2<f32>", "vec3<f32>"),
+        vector_types=("f32", "vec2<f32>", "vec3<f32>", "vec4<f32>"),
         int_type="i32",
     ),
     Target(
@@ -104,7 +104,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         },
         # templates/opencl/ spell double/double2/double3 from `precision`
         precisions=OPENCL_PRECISIONS,
-        vector_types=("float", "float2", "float3"),
+        vector_types=("float", "float2", "float3", "float4"),
         params_read_as="argument",
     ),
 )}
