@@ -109,6 +109,14 @@ fuzz: setup
 corpus: setup
 	$(PY) -m implc corpus -j 2 -o docs/CORPUS.md
 
+# -m interval over the corpus's non-polynomial rows that compile today with the default
+# method: compiled for glsl, wgsl and opencl and validated, or refused with the reason; the
+# summary also as Markdown in out/corpus-interval.md. 1-2 minutes with 2 workers (53-97 s).
+.PHONY: corpus-interval
+corpus-interval: setup
+	@mkdir -p $(OUT)
+	$(PY) scripts/corpus_interval.py -j 2 -o $(OUT)/corpus-interval.md
+
 # Compile time of every corpus row as a user meets it (`implc compile -e ROW`, default
 # method, GLSL, a fresh process each, two at a time): the distribution and the slowest
 # ten (docs/RESULTS.md section 6). About 2 minutes on 2 cores.
