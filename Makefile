@@ -111,7 +111,7 @@ corpus: setup
 
 # -m interval over the corpus's non-polynomial rows that compile today with the default
 # method: compiled for glsl, wgsl and opencl and validated, or refused with the reason; the
-# summary also as Markdown in out/corpus-interval.md. 1-2 minutes with 2 workers (53-97 s).
+# summary also as Markdown in out/corpus-interval.md. 1-2 minutes with 2 workers (53-130 s measured).
 .PHONY: corpus-interval
 corpus-interval: setup
 	@mkdir -p $(OUT)
