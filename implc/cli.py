@@ -227,7 +227,8 @@ def build_parser() -> argparse.ArgumentParser:
     _surface_args(p)
     p.add_argument("-m", "--method", choices=sorted(METHODS), default=None,
                    help="method whose shader functions to count (default: exact for "
-                        "polynomials, else hessian)")
+                        "polynomials, else interval where every function has an interval "
+                        "rule, else hessian)")
     p.set_defaults(run=cmd_show)
 
     p = sub.add_parser("compile", help="emit a shader for a surface",
@@ -368,7 +369,9 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
 def _method_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-m", "--method", choices=list(METHODS), default=None,
                    help="root-finding method (default: exact for polynomial surfaces up to "
-                        f"degree {EXACT_MAX_DEGREE}, else hessian); see README \"The methods\"")
+                        f"degree {EXACT_MAX_DEGREE}, else interval where every function has "
+                        "an interval rule (not atan2), else hessian); see README \"The "
+                        "methods\"")
     d = Constants()
     c = p.add_argument_group("method constants (defaults: the paper's Table 1)")
     c.add_argument("--step", type=float, help="base step b (default 0.01; hessian 0.002)")
@@ -461,8 +464,8 @@ def cmd_list(args) -> int:
 
 
 def _resolve_method(args, surface) -> None:
-    """-m's default depends on the surface: exact where it applies, else hessian."""
-    from .solver import default_method
+    """-m's default depends on the surface (marcher.default_method)."""
+    from .marcher import default_method
 
     if args.method is None:
         args.method = default_method(surface.expr)

@@ -101,14 +101,16 @@ class _Builder:
         self.lets: list[tuple[sympy.Symbol, sympy.Basic]] = []
         self.dead: list[sympy.Basic] = []
         self.memo: dict[sympy.Basic, tuple[sympy.Expr, sympy.Expr]] = {}
+        self.named: dict[sympy.Basic, sympy.Symbol] = {}  # a value let twice: one name
 
     # --- lets and widening -------------------------------------------------------------
     def let(self, value: sympy.Basic, stem: str) -> sympy.Expr:
         if value.is_Atom:
             return value
-        name = sympy.Symbol(f"{stem}{len(self.lets)}", real=True)
-        self.lets.append((name, value))
-        return name
+        if value not in self.named:
+            self.named[value] = sympy.Symbol(f"{stem}{len(self.lets)}", real=True)
+            self.lets.append((self.named[value], value))
+        return self.named[value]
 
     def widened(self, lo: sympy.Expr, hi: sympy.Expr, ulps: float = 1,
                 absolute: float = 0) -> tuple[sympy.Expr, sympy.Expr]:
@@ -137,9 +139,12 @@ class _Builder:
             i = POINT.index(node)
             o, d = ORIGIN[i], DIRECTION[i]
             ends = (self.let(A * d, "r"), self.let(B * d, "r"))
-            # (the products' and the sum's roundings: two units)
-            return self.widened(o + Min(*ends, evaluate=False), o + Max(*ends, evaluate=False),
-                                2)
+            lo = self.let(o + Min(*ends, evaluate=False), "r")
+            hi = self.let(o + Max(*ends, evaluate=False), "r")
+            # the product's rounding and the sum's: a unit of each (the sum may cancel, so
+            # the product's is in units of its own size)
+            return (self.let(lo - ((Abs(lo) + Abs(ends[0]) + Abs(ends[1])) * ULP + TINY), "lo"),
+                    self.let(hi + ((Abs(hi) + Abs(ends[0]) + Abs(ends[1])) * ULP + TINY), "hi"))
         if node in DIRECTION_SYMBOLS:  # (in F' = grad S . d) the ray's direction
             d = DIRECTION[DIRECTION_SYMBOLS.index(node)]
             return d, d

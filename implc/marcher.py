@@ -25,7 +25,13 @@ import sympy
 
 from .derive import polynomial_degree
 from .errors import InputError
-from .interval import derivative_program, range_constants, range_function, range_program
+from .interval import (
+    check_interval,
+    derivative_program,
+    range_constants,
+    range_function,
+    range_program,
+)
 from .methods import (
     CONSTANT_SYMBOLS,
     D0,
@@ -54,7 +60,7 @@ from .pieces import (
     sym,
 )
 from .raypoly import carry, coefficient_program, estrin_function, from_ray, ray_name, ray_setup
-from .solver import check_exact, lower_solver
+from .solver import EXACT_MAX_DEGREE, check_exact, lower_solver
 
 FORMS = ("point", "ray-poly")
 EVAL_CHOICES = ("auto", *FORMS)
@@ -99,6 +105,21 @@ def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
     if requested != "auto":
         return requested
     return "ray-poly" if degree is not None and degree <= AUTO_MAX_DEGREE else "point"
+
+
+def default_method(expr: sympy.Expr) -> str:
+    """The method `-m` defaults to: `exact` for polynomials up to EXACT_MAX_DEGREE (no false
+    and no missed roots, the fastest there), `interval` for any other surface whose
+    functions all have interval rules (no missed sign change; faster than hessian on every
+    bundled non-polynomial, docs/RESULTS.md), else `hessian`."""
+    degree = polynomial_degree(expr)
+    if degree is not None and degree <= EXACT_MAX_DEGREE:
+        return "exact"
+    try:
+        check_interval(expr)
+    except InputError:
+        return "hessian"
+    return "interval"
 
 
 # --- what a method evaluates where ---------------------------------------------------

@@ -75,14 +75,6 @@ def check_exact(expr: sympy.Expr) -> int:
     return degree
 
 
-def default_method(expr: sympy.Expr) -> str:
-    """The method `-m` defaults to: `exact` where it applies (polynomials up to
-    EXACT_MAX_DEGREE; measured the most accurate there, and the fastest up to degree 6),
-    else `hessian`."""
-    degree = polynomial_degree(expr)
-    return "exact" if degree is not None and degree <= EXACT_MAX_DEGREE else "hessian"
-
-
 @dataclass(frozen=True)
 class Solver:
     """What templates/solver.j2 needs for the `exact` method on a degree-n polynomial."""

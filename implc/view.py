@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .emit import emit, param_uniforms, render_template
+from .marcher import default_method
 from .methods import Constants, get_method
-from .solver import default_method
 from .surface import Surface
 
 # A slider spans value +- max(|value|, SLIDER_MIN_HALF_WIDTH) in SLIDER_TICKS steps.
@@ -52,7 +52,7 @@ def sliders(surface: Surface) -> list[Slider]:
 def viewer_page(surface: Surface, method: str | None = None,
                 constants: Constants | None = None, webgpu: bool = True) -> str:
     """The HTML text of the viewer for `surface` (deterministic, byte for byte); the
-    method defaults as for `implc compile` (exact for polynomials, else hessian)."""
+    method defaults as for `implc compile` (marcher.default_method)."""
     method = method or default_method(surface.expr)
     meth = get_method(method)
     constants = constants or meth.defaults
@@ -63,7 +63,7 @@ def viewer_page(surface: Surface, method: str | None = None,
         "surface": {"name": surface.name, "equation": surface.symbolic_equation,
                     "origin": surface.origin},
         "method": {"name": meth.name, "summary": meth.summary,
-                   "step": None if meth.solves else constants.step,
+                   "step": None if meth.solves or meth.bounds else constants.step,
                    "taylor2": constants.taylor2, "uses_taylor2": meth.reads_taylor2},
         "view": {"eye": list(view.eye), "target": list(view.target), "up": list(view.up),
                  "fov_y": view.fov_y_deg, "clip_center": list(view.clip_center),
