@@ -21,7 +21,7 @@ Because min and max pick one of their (already widened) arguments exactly, and e
 widens by the rounding of its own result, every bound encloses the exact interval
 extension of the rounded inputs by induction. Functions add their row's `error` (ulps
 relative, and absolute), an implementation's accuracy as measured on llvmpipe and PoCL
-(tests/test_interval.py measures it against float64 and fails when a function errs
+(tests/test_interval_widening.py measures it against float64 and fails when a function errs
 beyond its widening). An enclosure that overflows (inf, NaN) is never skipped: the march
 splits it down to its resolution limit, where the sign test decides.
 """

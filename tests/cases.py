@@ -11,12 +11,14 @@ GLSL_FLAVORS = ("330", "450", "es300", "shadertoy")
 
 def golden_cases() -> list[tuple[str, str, str, str]]:
     """(example, method, flavor, emit): every example with hessian in every flavour, every
-    method on the paper surfaces, and a library emit of each paper surface."""
+    method on the paper surfaces, a library emit of each paper surface, and the gyroid
+    with interval (program and library)."""
     cases = [(ex, "hessian", fl, "program") for ex in EXAMPLES for fl in GLSL_FLAVORS]
     cases += [(ex, m, "330", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
     cases += [(ex, m, "330", "library") for ex in PAPER for m in ("hessian", "taylor")]
     cases += [("cross-cap", "exact", fl, "program") for fl in GLSL_FLAVORS if fl != "330"]
     cases += [("cross-cap", "exact", "330", "library")]
+    cases += [("gyroid", "interval", "330", "program"), ("gyroid", "interval", "330", "library")]
     return cases
 
 
@@ -36,6 +38,7 @@ def opencl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [("cross-cap", "hessian", "double", "program")]
     cases += [("cross-cap", "exact", "float", "library"),
               ("cross-cap", "exact", "double", "program")]
+    cases += [("gyroid", "interval", "float", "program"), ("gyroid", "interval", "float", "library")]
     return cases
 
 
@@ -58,6 +61,7 @@ def wgsl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [(ex, "hessian", "paper", "library") for ex in PAPER]
     cases += [("cross-cap", "taylor", "paper", "library"),
               ("cross-cap", "exact", "paper", "library")]
+    cases += [("gyroid", "interval", "paper", "program"), ("gyroid", "interval", "paper", "library")]
     return cases
 
 
