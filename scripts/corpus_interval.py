@@ -1,13 +1,13 @@
-"""`-m interval` over the corpus: every non-polynomial row that loads and compiles today
-with the default method (`hessian` there: implc/solver.py default_method) is compiled
+"""`-m interval` over the corpus: every non-polynomial row that loads and compiles with
+`hessian` (the marchers' method, the default there before interval) is compiled
 with the interval method on glsl, wgsl and opencl and validated by each target's real
 compiler (implc/validate.py), or refused with the interval method's reason (a function
 without an interval rule, e.g. atan2, or a power with a variable exponent).
 
     python scripts/corpus_interval.py [TSV] [-j 2] [-o FILE.md]
 
-Polynomial rows are scripts/corpus_exact.py's. "Compiles today" means the default
-method emits the program for every target (`implc compile -e ROW` without --validate;
+Polynomial rows are scripts/corpus_exact.py's. "Compiles today" means hessian emits
+the program for every target (`implc compile -e ROW` without --validate;
 `make corpus` validates those). Prints a summary table; `-o` writes it as Markdown.
 """
 
@@ -41,7 +41,6 @@ def _check_row(row) -> tuple[int, str, str, str, dict[str, str]]:
     from implc.derive import polynomial_degree
     from implc.emit import emit
     from implc.errors import ImplcError, ToolError
-    from implc.solver import default_method
     from implc.validate import validate_text
 
     statuses = {t: "-" for t in TARGETS}
@@ -51,7 +50,7 @@ def _check_row(row) -> tuple[int, str, str, str, dict[str, str]]:
         return row.number, row.name, "not-loaded", _first(str(err)), statuses
     if polynomial_degree(surface.expr) is not None:
         return row.number, row.name, "polynomial", "", statuses
-    default = default_method(surface.expr)
+    default = "hessian"  # what rendered these rows before interval (the marchers)
     for target in TARGETS:
         try:
             emit(surface, target, default)
@@ -106,7 +105,7 @@ def summary(results, tsv, seconds: float) -> str:
         f"# -m interval on the corpus ({len(results)} rows of {tsv.name})",
         "",
         f"scripts/corpus_interval.py, {seconds:.0f} s. Each non-polynomial row that loads "
-        "and compiles with the default method is compiled with `-m interval` for "
+        "and compiles with `-m hessian` is compiled with `-m interval` for "
         f"{', '.join(TARGETS)} and validated by each target's compiler.",
         "",
         "| rows | count |",
@@ -114,7 +113,7 @@ def summary(results, tsv, seconds: float) -> str:
         f"| in the corpus | {len(results)} |",
         f"| not loaded (implc refuses the equation) | {counts['not-loaded']} |",
         f"| polynomial (scripts/corpus_exact.py) | {counts['polynomial']} |",
-        f"| non-polynomial, the default method fails | {counts['default-fails']} |",
+        f"| non-polynomial, hessian fails | {counts['default-fails']} |",
         f"| non-polynomial, compiled today: tried with -m interval | {len(tried)} |",
         f"| -m interval refused | {counts['refused']} |",
         f"| -m interval compiles on every target | {len(compiled)} |",

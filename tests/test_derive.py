@@ -188,7 +188,7 @@ def test_degree_is_computed_once_per_compile():
     default method, the evaluation form, exact's check and the ray coefficients all ask
     it, and one compile computes it once."""
     from implc.derive import polynomial_degree
-    from implc.solver import default_method
+    from implc.marcher import default_method
 
     surface = load_surface(equation="x^4 + y^4 + z^4 - 1 + x y z/7")  # fresh: not cached
     before = polynomial_degree.cache_info()
