@@ -38,7 +38,7 @@ def opencl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [("cross-cap", "hessian", "double", "program")]
     cases += [("cross-cap", "exact", "float", "library"),
               ("cross-cap", "exact", "double", "program")]
-    cases += [("gyroid", "interval", "float", "program"), ("gyroid", "interval", "float", "library")]
+    cases += [("gyroid", "interval", "float", kind) for kind in ("program", "library")]
     return cases
 
 
@@ -61,7 +61,7 @@ def wgsl_golden_cases() -> list[tuple[str, str, str, str]]:
     cases += [(ex, "hessian", "paper", "library") for ex in PAPER]
     cases += [("cross-cap", "taylor", "paper", "library"),
               ("cross-cap", "exact", "paper", "library")]
-    cases += [("gyroid", "interval", "paper", "program"), ("gyroid", "interval", "paper", "library")]
+    cases += [("gyroid", "interval", "paper", kind) for kind in ("program", "library")]
     return cases
 
 

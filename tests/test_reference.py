@@ -8,7 +8,6 @@ import sympy
 
 from implc.numeric import evaluate
 from implc.render.reference import (
-    DENSE_SAMPLES,
     DIRECTION,
     ORIGIN,
     dense_first_roots,
@@ -256,7 +255,8 @@ def test_non_polynomial_surface_renders_with_small_residual():
     assert result.hit.sum() > 300
     assert np.all(result.residual[result.hit] < 1e-10)
     inside = clip_sphere(*pixel_rays(view, 48, 48), view.clip_center, view.clip_radius)[2]
-    assert np.array_equal(result.steps, np.where(inside, DENSE_SAMPLES, 0).astype(np.float32))
+    # steps: the certified search's nodes per ray, on every ray through the clip sphere
+    assert np.array_equal(result.steps > 0, inside)
 
 
 def test_unbound_parameter_is_an_error():
