@@ -66,9 +66,9 @@ class Marcher:
     step: Code
     root: Code
     solver: Solver | None = None
-    interval: bool = False  # the interval march (templates/interval.j2)
-    monotone: bool = False  # interval: with F''s enclosure (DF_range), a monotonic test
     carried: tuple[tuple[str, str], ...] = ()  # see `lower`
+    interval: bool = False  # the interval march (templates/interval.j2)
+    monotone: bool = False  # interval: with F''s enclosure (FD_range), a monotonic test
 
     @property
     def carried_args(self) -> str:
