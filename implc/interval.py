@@ -39,10 +39,14 @@ from .pieces import ShaderFunction, sym
 from .symbols import DIRECTION as DIRECTION_SYMBOLS
 from .symbols import POINT
 
-# The march's bounds: a node no wider than 2^-DEPTH of the chord is a leaf (a sign change of
-# F between its ends is a root, refined; else a touching root where |F| at its middle is
-# at most TOUCH), and a ray visits at most MAX_NODES nodes.
+# The march's bounds: the walk starts with nodes of 2^-START of the chord (measured at
+# 512^2 against starting with the whole chord, frame time / taylor's: gyroid 1.15 -> 1.01,
+# csg 1.07 -> 1.05, blobs 0.50 -> 0.52; a hit ray's first levels never exclude 0, and 3
+# cost the blobs' missing rays 1.34), a node no wider than 2^-DEPTH of the chord is a leaf
+# (a sign change of F between its ends is a root, refined; else a touching root where |F|
+# at its middle is at most TOUCH), and a ray visits at most MAX_NODES nodes.
 DEPTH = 16
+START = 2
 MAX_NODES = 1024
 TOUCH = 1e-7
 
@@ -284,6 +288,7 @@ def range_constants(printer, prefix: str) -> tuple[tuple[str, str, str], ...]:
     ulp, tiny = WIDENING[getattr(printer, "precision", "float")]
     return (("real", K + "IV_ULP", printer.float_literal(ulp)),
             ("real", K + "IV_TINY", printer.float_literal(tiny)),
+            ("real", K + "START_WIDTH", printer.float_literal(2.0**-START)),
             ("real", K + "MIN_WIDTH", printer.float_literal(2.0**-DEPTH)),
             ("real", K + "TOUCH", printer.float_literal(TOUCH)),
             ("int", K + "DEPTH", str(DEPTH)),

@@ -20,6 +20,7 @@ layout(location = 1) out vec4 frag_aux;    // (hit 0/1, t from the eye, march st
 // Method constants (implc compile options).
 const float IV_ULP = 2.384185791015625e-07;
 const float IV_TINY = 1.1754943508222875e-38;
+const float START_WIDTH = 0.25;
 const float MIN_WIDTH = 1.52587890625e-05;
 const float TOUCH = 1e-07;
 const int DEPTH = 16;
@@ -304,7 +305,7 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 }
 
 // Interval march (the `interval` method) over [t0, t1] of the ray ro + t rd (|rd| = 1):
-// the chord is cut in halves, quarters, ... (nodes; pos and width are dyadic fractions of
+// the chord is cut in quarters (START_WIDTH), eighths, ... (nodes; pos and width are dyadic fractions of
 // the chord, so every node's ends are exact and shared with its neighbours). A node where
 // F's enclosure (F_range) excludes 0 holds no root and is skipped whole; any other node is
 // halved, down to leaves no wider than MIN_WIDTH of the chord, where F's sign change
@@ -323,7 +324,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
     float fa = 0.0;
     float fb = 0.0;
     float pos = 0.0;
-    float width = 1.0;
+    float width = START_WIDTH;
     int index = 0;
     int nodes = 0;
     for (int node = 0; node < MAX_NODES; ++node) {
@@ -333,38 +334,31 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
         vec4 fd = FD_range(ray, na, nb);
         vec2 r = fd.xy;
         vec2 dr = fd.zw;
-        bool descend = false;
         // (an enclosure that overflowed to NaN fails both tests: it is never skipped)
-        if (!(r.x > 0.0 || r.y < 0.0)) {
-            if (dr.x > 0.0 || dr.y < 0.0) {
-                // F is monotonic on the node (its derivative's enclosure excludes 0): a
-                // sign change between its ends is its one root, no sign change none
-                float f0 = S(ray.o + na*ray.d);
-                float f1 = S(ray.o + nb*ray.d);
-                if (f0*f1 <= 0.0) {
-                    found = true;
-                    a = na;
-                    b = nb;
-                    fa = f0;
-                    fb = f1;
-                    break;
-                }
-            } else if (width > MIN_WIDTH) {
-                descend = true;
-            } else {
-                float f0 = S(ray.o + na*ray.d);
-                float f1 = S(ray.o + nb*ray.d);
-                float nm = 0.5*(na + nb);
-                if (f0*f1 <= 0.0 || abs(S(ray.o + nm*ray.d)) <= TOUCH) {
-                    // a sign change (or a touching root, which the refinement's Newton,
-                    // unbracketed, only clamps to the leaf)
-                    found = true;
-                    a = na;
-                    b = nb;
-                    fa = f0;
-                    fb = f1;
-                    break;
-                }
+        bool holds = !(r.x > 0.0 || r.y < 0.0);
+        // F is monotonic on the node where its derivative's enclosure excludes 0: a sign
+        // change between its ends is its one root, no sign change none
+        bool monotonic = holds && (dr.x > 0.0 || dr.y < 0.0);
+        bool leaf = holds && !monotonic && width <= MIN_WIDTH;
+        bool descend = holds && !monotonic && !leaf;
+        if (monotonic || leaf) {
+            // one evaluation of F's ends for both cases (a SIMD group whose lanes take
+            // either pays for it once)
+            float f0 = S(ray.o + na*ray.d);
+            float f1 = S(ray.o + nb*ray.d);
+            bool root = f0*f1 <= 0.0;
+            if (leaf && !root) {
+                // a leaf that may still hold a root: a touching root where |F| <= TOUCH
+                // at its middle (the refinement's Newton, unbracketed, is clamped to it)
+                root = abs(S(ray.o + 0.5*(na + nb)*ray.d)) <= TOUCH;
+            }
+            if (root) {
+                found = true;
+                a = na;
+                b = nb;
+                fa = f0;
+                fb = f1;
+                break;
             }
         }
         if (descend) {
@@ -379,7 +373,7 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
             }
             index += 1;
             for (int up = 0; up < DEPTH; ++up) {
-                if ((index & 1) == 1) {
+                if ((index & 1) == 1 || width >= START_WIDTH) {
                     break;
                 }
                 index = (index >> 1);

@@ -21,6 +21,7 @@
 // Method constants (implc compile options).
 __constant float GYROID_IV_ULP = 2.384185791015625e-07f;
 __constant float GYROID_IV_TINY = 1.1754943508222875e-38f;
+__constant float GYROID_START_WIDTH = 0.25f;
 __constant float GYROID_MIN_WIDTH = 1.52587890625e-05f;
 __constant float GYROID_TOUCH = 1e-07f;
 __constant int GYROID_DEPTH = 16;
@@ -360,7 +361,7 @@ float gyroid_refine(gyroid_Ray ray, float a0, float b0, float fa0, float fb) {
 }
 
 // Interval march (the `interval` method) over [t0, t1] of the ray ro + t rd (|rd| = 1):
-// the chord is cut in halves, quarters, ... (nodes; pos and width are dyadic fractions of
+// the chord is cut in quarters (START_WIDTH), eighths, ... (nodes; pos and width are dyadic fractions of
 // the chord, so every node's ends are exact and shared with its neighbours). A node where
 // F's enclosure (F_range) excludes 0 holds no root and is skipped whole; any other node is
 // halved, down to leaves no wider than MIN_WIDTH of the chord, where F's sign change
@@ -379,7 +380,7 @@ gyroid_Hit gyroid_trace(float3 ro, float3 rd, float t0, float t1) {
     float fa = 0.0f;
     float fb = 0.0f;
     float pos = 0.0f;
-    float width = 1.0f;
+    float width = GYROID_START_WIDTH;
     int index = 0;
     int nodes = 0;
     for (int node = 0; node < GYROID_MAX_NODES; ++node) {
@@ -389,38 +390,31 @@ gyroid_Hit gyroid_trace(float3 ro, float3 rd, float t0, float t1) {
         float4 fd = gyroid_FD_range(ray, na, nb);
         float2 r = fd.xy;
         float2 dr = fd.zw;
-        bool descend = false;
         // (an enclosure that overflowed to NaN fails both tests: it is never skipped)
-        if (!(r.x > 0.0f || r.y < 0.0f)) {
-            if (dr.x > 0.0f || dr.y < 0.0f) {
-                // F is monotonic on the node (its derivative's enclosure excludes 0): a
-                // sign change between its ends is its one root, no sign change none
-                float f0 = gyroid_S(ray.o + na*ray.d);
-                float f1 = gyroid_S(ray.o + nb*ray.d);
-                if (f0*f1 <= 0.0f) {
-                    found = true;
-                    a = na;
-                    b = nb;
-                    fa = f0;
-                    fb = f1;
-                    break;
-                }
-            } else if (width > GYROID_MIN_WIDTH) {
-                descend = true;
-            } else {
-                float f0 = gyroid_S(ray.o + na*ray.d);
-                float f1 = gyroid_S(ray.o + nb*ray.d);
-                float nm = 0.5f*(na + nb);
-                if (f0*f1 <= 0.0f || fabs(gyroid_S(ray.o + nm*ray.d)) <= GYROID_TOUCH) {
-                    // a sign change (or a touching root, which the refinement's Newton,
-                    // unbracketed, only clamps to the leaf)
-                    found = true;
-                    a = na;
-                    b = nb;
-                    fa = f0;
-                    fb = f1;
-                    break;
-                }
+        bool holds = !(r.x > 0.0f || r.y < 0.0f);
+        // F is monotonic on the node where its derivative's enclosure excludes 0: a sign
+        // change between its ends is its one root, no sign change none
+        bool monotonic = holds && (dr.x > 0.0f || dr.y < 0.0f);
+        bool leaf = holds && !monotonic && width <= GYROID_MIN_WIDTH;
+        bool descend = holds && !monotonic && !leaf;
+        if (monotonic || leaf) {
+            // one evaluation of F's ends for both cases (a SIMD group whose lanes take
+            // either pays for it once)
+            float f0 = gyroid_S(ray.o + na*ray.d);
+            float f1 = gyroid_S(ray.o + nb*ray.d);
+            bool root = f0*f1 <= 0.0f;
+            if (leaf && !root) {
+                // a leaf that may still hold a root: a touching root where |F| <= TOUCH
+                // at its middle (the refinement's Newton, unbracketed, is clamped to it)
+                root = fabs(gyroid_S(ray.o + 0.5f*(na + nb)*ray.d)) <= GYROID_TOUCH;
+            }
+            if (root) {
+                found = true;
+                a = na;
+                b = nb;
+                fa = f0;
+                fb = f1;
+                break;
             }
         }
         if (descend) {
@@ -435,7 +429,7 @@ gyroid_Hit gyroid_trace(float3 ro, float3 rd, float t0, float t1) {
             }
             index += 1;
             for (int up = 0; up < GYROID_DEPTH; ++up) {
-                if ((index & 1) == 1) {
+                if ((index & 1) == 1 || width >= GYROID_START_WIDTH) {
                     break;
                 }
                 index = (index >> 1);

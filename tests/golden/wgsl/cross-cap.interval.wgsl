@@ -30,6 +30,7 @@ struct Uniforms {
 // Method constants (implc compile options).
 const IV_ULP: f32 = 2.384185791015625e-07f;
 const IV_TINY: f32 = 1.1754943508222875e-38f;
+const START_WIDTH: f32 = 0.25f;
 const MIN_WIDTH: f32 = 1.52587890625e-05f;
 const TOUCH: f32 = 1e-07f;
 const DEPTH: i32 = 16;
@@ -331,7 +332,7 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 }
 
 // Interval march (the `interval` method) over [t0, t1] of the ray ro + t rd (|rd| = 1):
-// the chord is cut in halves, quarters, ... (nodes; pos and width are dyadic fractions of
+// the chord is cut in quarters (START_WIDTH), eighths, ... (nodes; pos and width are dyadic fractions of
 // the chord, so every node's ends are exact and shared with its neighbours). A node where
 // F's enclosure (F_range) excludes 0 holds no root and is skipped whole; any other node is
 // halved, down to leaves no wider than MIN_WIDTH of the chord, where F's sign change
@@ -350,7 +351,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     var fa: f32 = 0.0f;
     var fb: f32 = 0.0f;
     var pos: f32 = 0.0f;
-    var width: f32 = 1.0f;
+    var width: f32 = START_WIDTH;
     var index: i32 = 0;
     var nodes: i32 = 0;
     for (var node: i32 = 0; node < MAX_NODES; node++) {
@@ -360,38 +361,31 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         let fd: vec4<f32> = FD_range(ray, na, nb);
         let r: vec2<f32> = fd.xy;
         let dr: vec2<f32> = fd.zw;
-        var descend: bool = false;
         // (an enclosure that overflowed to NaN fails both tests: it is never skipped)
-        if (!(r.x > 0.0f || r.y < 0.0f)) {
-            if (dr.x > 0.0f || dr.y < 0.0f) {
-                // F is monotonic on the node (its derivative's enclosure excludes 0): a
-                // sign change between its ends is its one root, no sign change none
-                let f0: f32 = S(ray.o + na*ray.d);
-                let f1: f32 = S(ray.o + nb*ray.d);
-                if (f0*f1 <= 0.0f) {
-                    found = true;
-                    a = na;
-                    b = nb;
-                    fa = f0;
-                    fb = f1;
-                    break;
-                }
-            } else if (width > MIN_WIDTH) {
-                descend = true;
-            } else {
-                let f0: f32 = S(ray.o + na*ray.d);
-                let f1: f32 = S(ray.o + nb*ray.d);
-                let nm: f32 = 0.5f*(na + nb);
-                if (f0*f1 <= 0.0f || abs(S(ray.o + nm*ray.d)) <= TOUCH) {
-                    // a sign change (or a touching root, which the refinement's Newton,
-                    // unbracketed, only clamps to the leaf)
-                    found = true;
-                    a = na;
-                    b = nb;
-                    fa = f0;
-                    fb = f1;
-                    break;
-                }
+        let holds: bool = !(r.x > 0.0f || r.y < 0.0f);
+        // F is monotonic on the node where its derivative's enclosure excludes 0: a sign
+        // change between its ends is its one root, no sign change none
+        let monotonic: bool = holds && (dr.x > 0.0f || dr.y < 0.0f);
+        let leaf: bool = holds && !monotonic && width <= MIN_WIDTH;
+        let descend: bool = holds && !monotonic && !leaf;
+        if (monotonic || leaf) {
+            // one evaluation of F's ends for both cases (a SIMD group whose lanes take
+            // either pays for it once)
+            let f0: f32 = S(ray.o + na*ray.d);
+            let f1: f32 = S(ray.o + nb*ray.d);
+            var root: bool = f0*f1 <= 0.0f;
+            if (leaf && !root) {
+                // a leaf that may still hold a root: a touching root where |F| <= TOUCH
+                // at its middle (the refinement's Newton, unbracketed, is clamped to it)
+                root = abs(S(ray.o + 0.5f*(na + nb)*ray.d)) <= TOUCH;
+            }
+            if (root) {
+                found = true;
+                a = na;
+                b = nb;
+                fa = f0;
+                fb = f1;
+                break;
             }
         }
         if (descend) {
@@ -406,7 +400,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             }
             index += 1;
             for (var up: i32 = 0; up < DEPTH; up++) {
-                if ((index & 1) == 1) {
+                if ((index & 1) == 1 || width >= START_WIDTH) {
                     break;
                 }
                 index = (index >> 1u);
