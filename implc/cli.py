@@ -254,6 +254,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("validate", help="check shader files with their real compilers")
     p.add_argument("files", nargs="+", type=Path, metavar="FILE")
+    p.add_argument("--stage", choices=("vert", "frag", "comp", "geom", "tesc", "tese"),
+                   help="GLSL files only: the shader stage (default: from the extension, "
+                        ".vert, .comp, ... or .vert.glsl; .frag and .glsl are frag)")
     p.set_defaults(run=cmd_validate)
 
     p = sub.add_parser("render", help="render a surface to PNG or EXR (+ JSON sidecar)")
@@ -541,7 +544,7 @@ def _surface(args, aspect: float = 1.0):
 
 class CommandLineError(InputError):
     """A bad command line found after parsing (view options that make a view which shows
-    nothing): exit 2, like argparse's own."""
+    nothing, `--stage` for a WGSL file): exit 2, like argparse's own."""
 
     exit_code = EXIT_USAGE
 
@@ -650,7 +653,7 @@ def cmd_validate(args) -> int:
     """Every file is checked (exists, readable, known extension, UTF-8) before any
     compiler runs: a bad input is exit 1, a shader its compiler rejects exit 3."""
     from .targets import target_of_file
-    from .validate import validate_text
+    from .validate import check_source, validate_text
 
     sources = []
     for path in args.files:
@@ -659,10 +662,15 @@ def cmd_validate(args) -> int:
             known = " ".join(sorted(ext for t in TARGETS.values() for ext in t.extensions))
             raise InputError(f"{path}: unknown shader extension '{path.suffix}' "
                              f"(known: {known})")
-        sources.append((path, target.name, read_input_text(path)))
+        if args.stage and target.name != "glsl":
+            raise CommandLineError(f"--stage applies to GLSL files only; {path} is "
+                                  f"{target.name}")
+        text = read_input_text(path)
+        check_source(text, str(path))
+        sources.append((path, target.name, text))
     failed = 0
     for path, target, text in sources:
-        verdict = validate_text(text, target, str(path))
+        verdict = validate_text(text, target, str(path), stage=args.stage)
         print(verdict.render(str(path)), file=sys.stdout if verdict.ok else sys.stderr)
         failed += not verdict.ok
     return EXIT_INVALID if failed else EXIT_OK
