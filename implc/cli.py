@@ -137,8 +137,10 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_OK
         from .derive import derive_limits
 
+        _NOTES.clear()
         with derive_limits(getattr(args, "max_derived", None)):
             code = args.run(args)
+        _print_notes()  # what framing chose, once the command has done its work
         sys.stdout.flush()  # a full disk under `> file` is reported here, not at exit
         return code
     except ImplcError as err:
@@ -542,6 +544,14 @@ def _surface(args, aspect: float = 1.0):
     return surface
 
 
+_NOTES: list[str] = []  # stderr lines kept until the command succeeds (_print_notes)
+
+
+def _print_notes() -> None:
+    while _NOTES:
+        print(_NOTES.pop(0), file=sys.stderr)
+
+
 class CommandLineError(InputError):
     """A bad command line found after parsing (view options that make a view which shows
     nothing, `--stage` for a WGSL file): exit 2, like argparse's own."""
@@ -550,12 +560,16 @@ class CommandLineError(InputError):
 
 
 def _with_view(args, surface, aspect: float):
-    """`surface` with the view the command line and automatic framing give it; prints
-    what framing chose (stderr)."""
+    """`surface` with the view the command line and automatic framing give it; what
+    framing chose is printed when the command succeeds (a refused or interrupted one
+    prints its error only)."""
     import dataclasses
 
+    from .derive import check_derived_size
     from .extent import SEARCHED, locate_surface
     from .scene import ViewOptions, apply_view, view_problems
+
+    check_derived_size(surface.expr)  # refuse a too complex surface before sampling it
 
     options = ViewOptions(radius=args.radius, center=args.center, eye=args.eye,
                           target=args.look_at, up=args.up, fov=args.fov)
@@ -569,7 +583,7 @@ def _with_view(args, surface, aspect: float):
             raise CommandLineError(f"{flags}: the view shows nothing: {problems[0][1]}")
         raise InputError(f"{surface.origin}: [view] {problems[0][1]}")
     if framing is not None:
-        print(framing.message(), file=sys.stderr)
+        _NOTES.append(framing.message())
     return dataclasses.replace(surface, view=view)
 
 
@@ -702,6 +716,7 @@ def cmd_render(args) -> int:
                                    height, args.output, params=args.params)
     elapsed = time.perf_counter() - start
     timing = result.timing
+    _print_notes()
     for path in paths:
         print(f"wrote {path}")
     what = backend if backend == "reference" else f"{backend}/{args.method}"
