@@ -373,10 +373,10 @@ VIEW_ABOUT = (
     "`target`). Which way is "
     "up: +y is up in the picture (the default `up`) unless the file's [view] sets `up`; an "
     "equation written z-up, like Taubin's heart typed with -e, lies on its side: --up z "
-    "stands it up. A surface given without a view (-e, or a file whose [view] sets "
-    "neither radius nor eye) is framed automatically: implc finds where S changes sign, "
-    "puts the clip sphere around it and the camera where the sphere fills the picture, "
-    "and prints what it chose (README \"Framing\").")
+    "stands it up. What neither the file nor an option sets is chosen and printed: "
+    "without a radius (every -e) implc finds where S changes sign and puts the clip "
+    "sphere around it; without an eye (unless the file sets radius) the camera goes where "
+    "the sphere fills the picture (README \"Framing\").")
 
 
 def _view_args(p: argparse.ArgumentParser) -> None:
@@ -404,7 +404,7 @@ def _view_args(p: argparse.ArgumentParser) -> None:
 
 
 def _point_arg(text: str) -> tuple[float, float, float]:
-    """argparse type of --center, --eye, --target: `X,Y,Z` (brackets allowed)."""
+    """argparse type of --center, --eye, --look-at: `X,Y,Z` (brackets allowed)."""
     parts = text.strip().strip("[]()").split(",")
     try:
         values = tuple(float(part) for part in parts)
@@ -754,9 +754,10 @@ def _render_warnings(surface, result, given_radius: bool) -> list[str]:
         where = f"--radius {extent.radius:g}"
         if extent.center != tuple(view.clip_center):
             where += f" --center {','.join(f'{c:g}' for c in extent.center)}"
+        found = (f"is found within radius {extent.radius:g} of {point_text(extent.center)}"
+                 if extent.bounded else f"passes near {point_text(extent.center)} (unbounded?)")
         return [f"implc: warning: no pixel hits the surface inside {sphere}; the surface "
-                f"is found within radius {extent.radius:g} of {point_text(extent.center)}: "
-                f"try {where}"]
+                f"{found}: try {where}"]
     if not ("radius" in view.given or given_radius):
         return []
     if not crosses_sphere(surface.expr, view.clip_center, view.clip_radius):

@@ -88,8 +88,8 @@ SHADING = Shading()
 
 # --------------------------------------------------------------------------- framing
 #
-# The command line's view options (`--radius --center --eye --target --up --fov`, named
-# as the [view] keys) override the file's values one by one. What neither sets is
+# The command line's view options (`--radius --center --eye --look-at --up --fov`, the
+# [view] keys; --look-at is `target`) override the file's values one by one. What neither sets is
 # chosen (README "Framing"):
 # - no `radius`: the clip sphere is the surface's, found by sampling S
 #   (implc/extent.py), centred on it (or on `center`); when no surface is found the
@@ -127,7 +127,10 @@ class Framing:
     def message(self) -> str:
         view = self.view
         if self.framed_sphere and self.extent is None:
-            return (f"no surface found in |x|,|y|,|z| <= {self.searched:g} (S changes sign "
+            where = (f"|x|,|y|,|z| <= {self.searched:g}" if not any(view.clip_center) else
+                     f"the cube of half-size {self.searched:g} around "
+                     f"{point_text(view.clip_center)}")
+            return (f"no surface found in {where} (S changes sign "
                     "nowhere on the search grids); keeping the default view (radius "
                     f"{view.clip_radius:g}; --radius, --center to set)")
         parts, options = [], []
