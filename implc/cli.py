@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import os
 import re
 import signal
@@ -28,6 +29,7 @@ from .errors import (
     EXIT_INVALID,
     EXIT_OK,
     EXIT_TERMINATED,
+    EXIT_USAGE,
     ImplcError,
     InputError,
     ValidationError,
@@ -135,8 +137,10 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_OK
         from .derive import derive_limits
 
+        _NOTES.clear()
         with derive_limits(getattr(args, "max_derived", None)):
             code = args.run(args)
+        _print_notes()  # what framing chose, once the command has done its work
         sys.stdout.flush()  # a full disk under `> file` is reported here, not at exit
         return code
     except ImplcError as err:
@@ -205,6 +209,10 @@ def _join_equation_values(argv: list[str]) -> list[str]:
             joined.append(f"--equation={value}")
             i += 2
             continue
+        if arg in VIEW_POINT_FLAGS and value is not None and re.match(r"-[\d.xyzXYZ]", value):
+            joined.append(f"{arg}={value}")  # `--eye -3,0,0`, `--up -z`
+            i += 2
+            continue
         joined.append(arg)
         i += 1
     return joined
@@ -235,6 +243,7 @@ def build_parser() -> argparse.ArgumentParser:
                        formatter_class=argparse.RawDescriptionHelpFormatter,
                        description="Emit a complete shader program or a drop-in library.")
     _surface_args(p)
+    _view_args(p)
     _shader_args(p)
     p.add_argument("--emit", choices=("program", "library"), default="program",
                    help="program: a complete shader; library: the functions only")
@@ -247,10 +256,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("validate", help="check shader files with their real compilers")
     p.add_argument("files", nargs="+", type=Path, metavar="FILE")
+    p.add_argument("--stage", choices=("vert", "frag", "comp", "geom", "tesc", "tese"),
+                   help="GLSL files only: the shader stage (default: from the extension, "
+                        ".vert, .comp, ... or .vert.glsl; .frag and .glsl are frag)")
     p.set_defaults(run=cmd_validate)
 
     p = sub.add_parser("render", help="render a surface to PNG or EXR (+ JSON sidecar)")
     _surface_args(p)
+    _view_args(p)
     _shader_args(p)
     p.add_argument("-b", "--backend", choices=[*BACKENDS, REFERENCE], default="gl",
                    help="; ".join([*(f"{name}: {b.about}" for name, b in BACKENDS.items()),
@@ -268,6 +281,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "it), orbit/zoom/pan, a slider per parameter. Its first "
                                    "frame is the surface's [view] camera, like `implc render`.")
     _surface_args(p)
+    _view_args(p)
     _method_args(p)
     p.add_argument("--no-webgpu", action="store_true",
                    help="leave the WGSL program out of the page (WebGL2 only)")
@@ -350,6 +364,95 @@ def _limit_args(p: argparse.ArgumentParser) -> None:
                             help=f"{text} (default {default})")
 
 
+VIEW_POINT_FLAGS = ("--center", "--eye", "--look-at", "--up")  # values may start with '-'
+# [view] key -> its option (`target` is --look-at: -t/--target is the shader language)
+VIEW_FLAGS = {"radius": "--radius", "center": "--center", "eye": "--eye",
+              "target": "--look-at", "up": "--up", "fov": "--fov"}
+VIEW_ABOUT = (
+    "Each option overrides the surface file's [view] key of the same name (--look-at: "
+    "`target`). Which way is "
+    "up: +y is up in the picture (the default `up`) unless the file's [view] sets `up`; an "
+    "equation written z-up, like Taubin's heart typed with -e, lies on its side: --up z "
+    "stands it up. What neither the file nor an option sets is chosen and printed: "
+    "without a radius (every -e) implc finds where S changes sign and puts the clip "
+    "sphere around it; without an eye (unless the file sets radius) the camera goes where "
+    "the sphere fills the picture (README \"Framing\").")
+
+
+def _view_args(p: argparse.ArgumentParser) -> None:
+    """The camera and clip sphere on the command line (`render`, `view`, `compile`)."""
+    v = p.add_argument_group("view", VIEW_ABOUT)
+    v.add_argument("--radius", type=_radius_arg, metavar="R",
+                   help="clip sphere radius: only what lies inside is drawn (default: the "
+                        "file's, else framed automatically)")
+    v.add_argument("--center", type=_point_arg, metavar="X,Y,Z",
+                   help="clip sphere centre (default: the file's, else the surface's middle "
+                        "when framed automatically, else the origin)")
+    v.add_argument("--eye", type=_point_arg, metavar="X,Y,Z",
+                   help="camera position (default: the file's, else placed where the clip "
+                        "sphere fills the picture)")
+    v.add_argument("--look-at", type=_point_arg, metavar="X,Y,Z", dest="look_at",
+                   help="the point the camera looks at, [view] `target` (default: the "
+                        "clip sphere's centre)")
+    v.add_argument("--up", type=_up_arg, metavar="x|y|z|X,Y,Z",
+                   help="the world direction that is up in the picture (default y: +y is "
+                        "up, or the file's `up`); --up z for equations written z-up; -x, "
+                        "-y, -z turn it over")
+    v.add_argument("--fov", type=_fov_arg, metavar="DEG",
+                   help="vertical field of view in degrees (default: the file's, else 30)")
+    p.set_defaults(view_options=True)
+
+
+def _point_arg(text: str) -> tuple[float, float, float]:
+    """argparse type of --center, --eye, --look-at: `X,Y,Z` (brackets allowed)."""
+    parts = text.strip().strip("[]()").split(",")
+    try:
+        values = tuple(float(part) for part in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 3:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
+    if not all(math.isfinite(v) and abs(v) <= 1e6 for v in values):
+        raise argparse.ArgumentTypeError(f"each coordinate must be a finite number within "
+                                         f"1e6 of the origin, got {text!r}")
+    return values  # type: ignore[return-value]
+
+
+def _up_arg(text: str) -> tuple[float, float, float]:
+    """argparse type of --up: an axis (`z`, `-y`) or a direction `X,Y,Z`."""
+    axis = text.strip().lower()
+    sign = -1.0 if axis.startswith("-") else 1.0
+    if axis.lstrip("+-") in ("x", "y", "z"):
+        index = "xyz".index(axis.lstrip("+-"))
+        return tuple(sign if i == index else 0.0 for i in range(3))  # type: ignore[return-value]
+    if not re.match(r"[\s\[(]*[-+.\d]", text):
+        raise argparse.ArgumentTypeError(f"expected x, y, z (or -x, -y, -z) or a direction "
+                                         f"X,Y,Z, got {text!r}")
+    value = _point_arg(text)
+    if not any(value):
+        raise argparse.ArgumentTypeError("the up direction must not be 0,0,0")
+    return value
+
+
+def _radius_arg(text: str) -> float:
+    return _number_arg(text, 0.0, 1e6, "a clip sphere radius")
+
+
+def _fov_arg(text: str) -> float:
+    return _number_arg(text, 0.0, 180.0, "a field of view in degrees")
+
+
+def _number_arg(text: str, low: float, high: float, what: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not low < value < high:
+        raise argparse.ArgumentTypeError(f"{what} must be between {low:g} and {high:g} "
+                                         f"(exclusive), got {text}")
+    return value
+
+
 def _shader_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-t", "--target", choices=list(TARGETS), default="glsl",
                    help="shader language (default: glsl)")
@@ -429,10 +532,59 @@ def _limits(args):
     return Limits(**{k: v for k, v in given.items() if v is not None})
 
 
-def _surface(args):
+def _surface(args, aspect: float = 1.0):
+    """The surface; for `render`, `view` and `compile` with the view options applied and
+    a view framed automatically where none is given (`aspect`: the frame's width /
+    height, when known)."""
     from .surface import load_surface
 
-    return load_surface(args.surface, args.equation, args.param, _limits(args))
+    surface = load_surface(args.surface, args.equation, args.param, _limits(args))
+    if getattr(args, "view_options", False):
+        surface = _with_view(args, surface, aspect)
+    return surface
+
+
+_NOTES: list[str] = []  # stderr lines kept until the command succeeds (_print_notes)
+
+
+def _print_notes() -> None:
+    while _NOTES:
+        print(_NOTES.pop(0), file=sys.stderr)
+
+
+class CommandLineError(InputError):
+    """A bad command line found after parsing (view options that make a view which shows
+    nothing, `--stage` for a WGSL file): exit 2, like argparse's own."""
+
+    exit_code = EXIT_USAGE
+
+
+def _with_view(args, surface, aspect: float):
+    """`surface` with the view the command line and automatic framing give it; what
+    framing chose is printed when the command succeeds (a refused or interrupted one
+    prints its error only)."""
+    import dataclasses
+
+    from .derive import check_derived_size
+    from .extent import SEARCHED, locate_surface
+    from .scene import ViewOptions, apply_view, view_problems
+
+    check_derived_size(surface.expr)  # refuse a too complex surface before sampling it
+
+    options = ViewOptions(radius=args.radius, center=args.center, eye=args.eye,
+                          target=args.look_at, up=args.up, fov=args.fov)
+    view, framing = apply_view(surface.view, options,
+                               lambda center: locate_surface(surface.expr, center),
+                               aspect, SEARCHED)
+    problems = view_problems(view)
+    if problems:
+        flags = " ".join(VIEW_FLAGS[key] for key in sorted(options.given()))
+        if flags:
+            raise CommandLineError(f"{flags}: the view shows nothing: {problems[0][1]}")
+        raise InputError(f"{surface.origin}: [view] {problems[0][1]}")
+    if framing is not None:
+        _NOTES.append(framing.message())
+    return dataclasses.replace(surface, view=view)
 
 
 def _constants(args) -> Constants:
@@ -515,7 +667,7 @@ def cmd_validate(args) -> int:
     """Every file is checked (exists, readable, known extension, UTF-8) before any
     compiler runs: a bad input is exit 1, a shader its compiler rejects exit 3."""
     from .targets import target_of_file
-    from .validate import validate_text
+    from .validate import check_source, validate_text
 
     sources = []
     for path in args.files:
@@ -524,10 +676,15 @@ def cmd_validate(args) -> int:
             known = " ".join(sorted(ext for t in TARGETS.values() for ext in t.extensions))
             raise InputError(f"{path}: unknown shader extension '{path.suffix}' "
                              f"(known: {known})")
-        sources.append((path, target.name, read_input_text(path)))
+        if args.stage and target.name != "glsl":
+            raise CommandLineError(f"--stage applies to GLSL files only; {path} is "
+                                  f"{target.name}")
+        text = read_input_text(path)
+        check_source(text, str(path))
+        sources.append((path, target.name, text))
     failed = 0
     for path, target, text in sources:
-        verdict = validate_text(text, target, str(path))
+        verdict = validate_text(text, target, str(path), stage=args.stage)
         print(verdict.render(str(path)), file=sys.stdout if verdict.ok else sys.stderr)
         failed += not verdict.ok
     return EXIT_INVALID if failed else EXIT_OK
@@ -551,21 +708,68 @@ def cmd_render(args) -> int:
     backend = backend_for(args.backend, args.precision)  # a precision is a backend of its own
     check_output(args.output, (".png", ".exr"), what="a render",
                  companions=[args.output.with_suffix(".json")])
-    surface = _surface(args)
+    surface = _surface(args, width / height)
     _resolve_method(args, surface)
     _check_frame(surface, width, height)
     start = time.perf_counter()
-    paths, timing = render_surface(surface, backend, args.method, _constants(args), width,
+    paths, result = render_surface(surface, backend, args.method, _constants(args), width,
                                    height, args.output, params=args.params)
     elapsed = time.perf_counter() - start
+    timing = result.timing
+    _print_notes()
     for path in paths:
         print(f"wrote {path}")
     what = backend if backend == "reference" else f"{backend}/{args.method}"
     phases = ", ".join(f"{name} {timing[name]:.3f} s" for name in ("setup", "compile", "frame")
                        if name in timing)
-    print(f"rendered {width}x{height} with {what} in {elapsed:.2f} s ({phases})",
-          file=sys.stderr)
+    print(f"rendered {width}x{height} with {what} in {elapsed:.2f} s ({phases}); "
+          f"{_percent(result.hit)} of pixels hit", file=sys.stderr)
+    for line in _render_warnings(surface, result, given_radius=args.radius is not None):
+        print(line, file=sys.stderr)
     return EXIT_OK
+
+
+def _percent(hit) -> str:
+    """`38.4 %`; a few hits are `< 0.1 %`, not `0.0 %`."""
+    share = 100.0 * float(hit.mean())
+    return "< 0.1 %" if 0.0 < share < 0.1 else f"{share:.1f} %"
+
+
+def _render_warnings(surface, result, given_radius: bool) -> list[str]:
+    """What a user should know about a picture (exit 0): nothing hit, or the surface cut
+    by a clip sphere the file or --radius gave (a framed one says so when it frames)."""
+    from .extent import SEARCHED, crosses_sphere, locate_surface
+    from .scene import point_text
+
+    view = surface.view
+    sphere = (f"the clip sphere (center {point_text(view.clip_center)}, radius "
+              f"{view.clip_radius:g})")
+    if not result.hit.any():
+        extent = locate_surface(surface.expr)
+        if extent is None:
+            return [f"implc: warning: no pixel hits the surface, and S changes sign nowhere "
+                    f"in |x|,|y|,|z| <= {SEARCHED:g}: the equation may have no real "
+                    "points (S > 0 or S < 0 everywhere), or a part thinner than the search "
+                    "grid; --radius, --center to look elsewhere"]
+        where = f"--radius {extent.radius:g}"
+        if extent.center != tuple(view.clip_center):
+            where += f" --center {','.join(f'{c:g}' for c in extent.center)}"
+        found = (f"is found within radius {extent.radius:g} of {point_text(extent.center)}"
+                 if extent.bounded else f"passes near {point_text(extent.center)} (unbounded?)")
+        return [f"implc: warning: no pixel hits the surface inside {sphere}; the surface "
+                f"{found}: try {where}"]
+    if not ("radius" in view.given or given_radius):
+        return []
+    if not crosses_sphere(surface.expr, view.clip_center, view.clip_radius):
+        return []
+    extent = locate_surface(surface.expr, view.clip_center)
+    if extent is not None and not extent.bounded:
+        return [f"implc: note: the surface reaches {sphere}, and past |x|,|y|,|z| <= "
+                f"{SEARCHED:g} (unbounded?): the picture shows the part inside the sphere; "
+                "--radius to show more"]
+    hint = f"--radius {extent.radius:g} holds all of it" if extent else "--radius to widen it"
+    return [f"implc: warning: the surface reaches {sphere}: the picture is clipped there; "
+            f"{hint}"]
 
 
 def cmd_view(args) -> int:

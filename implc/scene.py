@@ -15,6 +15,7 @@ up = right x forward.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,6 +33,9 @@ class View:
     fov_y_deg: float = 30.0
     clip_center: Vec3 = (0.0, 0.0, 0.0)
     clip_radius: float = 1.5
+    # the [view] keys its surface file sets (empty for `-e`): what `apply_view` may
+    # choose instead (not part of the view's value)
+    given: frozenset[str] = field(default=frozenset(), compare=False, repr=False)
 
     def camera_json(self, width: int, height: int) -> dict:
         return {
@@ -80,6 +84,153 @@ class Shading:
 
 
 SHADING = Shading()
+
+
+# --------------------------------------------------------------------------- framing
+#
+# The command line's view options (`--radius --center --eye --look-at --up --fov`, the
+# [view] keys; --look-at is `target`) override the file's values one by one. What neither sets is
+# chosen (README "Framing"):
+# - no `radius`: the clip sphere is the surface's, found by sampling S
+#   (implc/extent.py), centred on it (or on `center`); when no surface is found the
+#   default view is kept and the caller says so;
+# - no `target`: the clip sphere's centre;
+# - no `eye`, and the radius is not the file's: the eye looks at the target from
+#   FRAME_DIRECTION, turned so that +y goes to `up`, at the distance where the clip
+#   sphere fills FRAME_FILL of the picture's shorter side. A file that sets `radius`
+#   and no `eye` keeps the default eye (3, 2, 4), as before framing existed.
+
+FRAME_DIRECTION = (3.0, 2.0, 4.0)  # the default eye's direction, for up = +y
+FRAME_FILL = 0.9
+
+
+@dataclass(frozen=True)
+class Extent:
+    """Where a surface was found (implc/extent.py): a clip sphere that holds it, or for
+    an unbounded surface the part near `center`."""
+
+    center: Vec3
+    radius: float
+    bounded: bool
+
+
+@dataclass(frozen=True)
+class Framing:
+    """What `apply_view` chose, for the one line the command line prints."""
+
+    view: View
+    framed_sphere: bool  # the clip sphere was searched for (no radius given)
+    extent: Extent | None  # what the search found (None: nothing; see framed_sphere)
+    placed_eye: bool
+    searched: float  # the half-size of the largest cube searched
+
+    def message(self) -> str:
+        view = self.view
+        if self.framed_sphere and self.extent is None:
+            where = (f"|x|,|y|,|z| <= {self.searched:g}" if not any(view.clip_center) else
+                     f"the cube of half-size {self.searched:g} around "
+                     f"{point_text(view.clip_center)}")
+            return (f"no surface found in {where} (S changes sign "
+                    "nowhere on the search grids); keeping the default view (radius "
+                    f"{view.clip_radius:g}; --radius, --center to set)")
+        parts, options = [], []
+        if self.framed_sphere:
+            parts.append(f"center {point_text(view.clip_center)}, radius {view.clip_radius:g}")
+            options += ["--radius", "--center"]
+        if self.placed_eye:
+            parts.append(f"eye {point_text(view.eye)}")
+            options.append("--eye")
+        text = f"framed: {', '.join(parts)} (auto; {', '.join(options)} to set)"
+        if self.extent is not None and not self.extent.bounded:
+            text += (f"; the surface reaches past |x|,|y|,|z| <= {self.searched:g} "
+                     "(unbounded?): this is the part near the centre")
+        return text
+
+
+@dataclass(frozen=True)
+class ViewOptions:
+    """The command line's view options; None: not given."""
+
+    radius: float | None = None
+    center: Vec3 | None = None
+    eye: Vec3 | None = None
+    target: Vec3 | None = None
+    up: Vec3 | None = None
+    fov: float | None = None
+
+    def given(self) -> set[str]:
+        return {key for key in VIEW_OPTION_KEYS if getattr(self, key) is not None}
+
+
+VIEW_OPTION_KEYS = ("radius", "center", "eye", "target", "up", "fov")  # the [view] keys
+
+
+def apply_view(
+    view: View, options: ViewOptions, locate: Callable[[Vec3 | None], Extent | None],
+    aspect: float = 1.0, searched: float = 0.0,
+) -> tuple[View, Framing | None]:
+    """`view` with the command line's `options` and what neither sets chosen by the rule
+    above; `locate(center or None)` finds the surface, called only when the clip sphere
+    is chosen (`searched`: how far it looks, for the message). The Framing is None when
+    nothing was chosen."""
+    given = set(view.given) | options.given()
+
+    def pick(option, value):
+        return value if option is None else option
+
+    center = pick(options.center, view.clip_center)
+    radius = pick(options.radius, view.clip_radius)
+    up = pick(options.up, view.up)
+    fov = pick(options.fov, view.fov_y_deg)
+    framed_sphere = "radius" not in given
+    placed_eye = "eye" not in given and "radius" not in view.given
+    extent = None
+    if framed_sphere:
+        extent = locate(center if "center" in given else None)
+        if extent is None:
+            placed_eye = False  # the default view, as it was
+        else:
+            center, radius = extent.center, extent.radius
+    target = pick(options.target, view.target if "target" in given else center)
+    eye = pick(options.eye, view.eye)
+    if placed_eye:
+        aim = np.asarray(target, dtype=np.float64)
+        off_centre = float(np.linalg.norm(np.asarray(center) - aim))
+        point = aim + (off_centre + fit_distance(radius, fov, aspect)) * frame_direction(up)
+        eye = (float(point[0]), float(point[1]), float(point[2]))
+    result = View(eye=eye, target=target, up=up, fov_y_deg=fov, clip_center=center,
+                  clip_radius=radius, given=view.given)
+    if not framed_sphere and not placed_eye:
+        return result, None
+    return result, Framing(result, framed_sphere, extent, placed_eye, searched)
+
+
+def frame_direction(up: Vec3) -> np.ndarray:
+    """FRAME_DIRECTION (unit) turned by the rotation that takes +y to `up`: the same
+    three-quarter view, whichever way is up ((3, -4, 2) for up = +z)."""
+    a = np.array([0.0, 1.0, 0.0])
+    b = np.asarray(up, dtype=np.float64) / np.linalg.norm(up)
+    d = np.asarray(FRAME_DIRECTION) / np.linalg.norm(FRAME_DIRECTION)
+    c = float(a @ b)
+    if c < -1.0 + 1e-12:  # up = -y: half a turn about x
+        return d * np.array([1.0, -1.0, -1.0])
+    v = np.cross(a, b)
+    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    rotation = np.eye(3) + k + k @ k / (1.0 + c)
+    return rotation @ d
+
+
+def fit_distance(radius: float, fov_y_deg: float, aspect: float = 1.0) -> float:
+    """How far from its centre a sphere of `radius` fills FRAME_FILL of the shorter side
+    of a picture with this vertical field of view and width / height."""
+    half = math.radians(fov_y_deg) / 2.0
+    if aspect < 1.0:  # taller than wide: the horizontal field of view is the smaller
+        half = math.atan(math.tan(half) * aspect)
+    return radius / math.sin(math.atan(FRAME_FILL * math.tan(half)))
+
+
+def point_text(v) -> str:
+    return "(" + ", ".join(f"{float(x):.3g}" for x in v) + ")"
 
 
 # --------------------------------------------------------------------------- view checks

@@ -227,13 +227,15 @@ def _view(where: _TomlMap, table) -> View:
                                              "(each coordinate within 1e6)", value=True)
         return (float(value[0]), float(value[1]), float(value[2]))
 
+    center = vector("center", default.clip_center)
     view = View(
         eye=vector("eye", default.eye),
-        target=vector("target", default.target),
+        target=vector("target", center),  # what it looks at: the clip sphere's centre
         up=vector("up", default.up),
         fov_y_deg=number("fov", default.fov_y_deg, 0.0, 180.0),
-        clip_center=vector("center", default.clip_center),
+        clip_center=center,
         clip_radius=number("radius", default.clip_radius, 0.0, 1e6),
+        given=frozenset(table),  # what the command line's framing leaves alone
     )
     for key, message in view_problems(view):
         # a default value is not in the file: point at the value that makes it wrong

@@ -3,9 +3,15 @@
 Which function validates which language, and which file extensions are which language,
 is the target registry's (implc/targets.py); this module holds the validators.
 
-GLSL: glslangValidator (Khronos reference front end). A shadertoy or library emit has no
-`#version`/`main`, so it is wrapped in templates/glsl/harness.glsl.j2 first and the
-tool's line numbers are mapped back into the user's file.
+GLSL: glslangValidator (Khronos reference front end). An implc library emit (its S, grad,
+intersect and shade under one prefix) and a Shadertoy image shader have no
+`#version`/`main`, so they are wrapped in templates/glsl/harness.glsl.j2 first; any other
+GLSL file is compiled as it is, in the stage its extension names (or `stage`), as
+`#version 330` when it has none (glslang's own default, ES 1.00, rejects `float` without
+a precision). The tool's line numbers are mapped back into the user's file.
+
+A file with no code (only whitespace and comments, which the three languages write
+alike) is refused by `check_source` in every language alike, before any compiler runs.
 """
 
 from __future__ import annotations
@@ -19,10 +25,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .devices import FP64, opencl_build, opencl_device, wgpu_device
-from .errors import ToolError
+from .errors import InputError, ToolError
 from .targets import TARGETS, resolve, target_of_file
 
-GLSL_STAGES = {".vert": "vert", ".comp": "comp"}  # any other GLSL file is a fragment shader
+# glslangValidator's stages by file extension; any other GLSL file (.frag, .glsl) is a
+# fragment shader unless `--stage` says otherwise or a compound suffix does (`.vert.glsl`)
+GLSL_STAGES = {".vert": "vert", ".frag": "frag", ".comp": "comp", ".geom": "geom",
+               ".tesc": "tesc", ".tese": "tese"}
+PLAIN_GLSL_VERSION = "330"  # for a plain GLSL file without #version
 
 
 @dataclass(frozen=True)
@@ -45,27 +55,51 @@ def find_tool(name: str) -> str:
 
 
 def glsl_kind(text: str) -> str:
-    """'program' (has #version), 'shadertoy' (has mainImage) or 'library'."""
+    """'program' (has #version), 'shadertoy' (has mainImage), 'library' (an implc
+    library emit) or 'plain' (any other GLSL: compiled as it is)."""
     if re.search(r"^\s*#version\b", text, re.M):
         return "program"
     if re.search(r"\bvoid\s+mainImage\s*\(", text):
         return "shadertoy"
-    return "library"
+    if _library_prefix(text) is not None:
+        return "library"
+    return "plain"
+
+
+def glsl_stage(name: str) -> str:
+    """The stage of a GLSL file by its extension: `x.vert`, `x.vert.glsl`; else frag."""
+    suffixes = Path(name).suffixes
+    if suffixes and suffixes[-1] == ".glsl" and len(suffixes) > 1:
+        return GLSL_STAGES.get(suffixes[-2], "frag")
+    return GLSL_STAGES.get(Path(name).suffix, "frag")
+
+
+def check_source(text: str, name: str) -> None:
+    """Refuse a shader file with no code: only whitespace and `//`, `/* */` comments
+    (one rule for GLSL, WGSL and OpenCL C, whose compilers would disagree on it)."""
+    code = re.sub(r"//[^\n]*|/\*.*?(\*/|\Z)", " ", text, flags=re.S)
+    if not code.strip():
+        raise InputError(f"{name}: empty file: no shader code to validate (only whitespace "
+                         "or comments)")
 
 
 def validate_glsl(text: str, name: str = "shader.frag", stage: str | None = None) -> Verdict:
-    """Validate GLSL with glslangValidator; `name` is used in the reported messages."""
+    """Validate GLSL with glslangValidator; `name` is used in the reported messages and
+    gives the stage (`glsl_stage`) unless `stage` does."""
     from .emit import render_template  # late: emit imports the whole pipeline
 
     tool = find_tool("glslangValidator")
     kind = glsl_kind(text)
-    stage = stage or GLSL_STAGES.get(Path(name).suffix, "frag")
+    stage = stage or glsl_stage(name)
     prelude = 0
     source = text
-    if kind != "program":
-        prefix = _library_prefix(text) if kind == "library" else ""
+    if kind in ("shadertoy", "library"):
+        prefix = _library_prefix(text) or ""
         source = render_template("glsl/harness.glsl.j2", kind=kind, body=text, prefix=prefix)
         prelude = source[: source.index(text)].count("\n")
+    elif kind == "plain":
+        source = f"#version {PLAIN_GLSL_VERSION}\n{text}"
+        prelude = 1
     with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
         path = os.path.join(tmp, f"shader.{stage}")
         Path(path).write_text(source, encoding="utf-8")
@@ -76,12 +110,24 @@ def validate_glsl(text: str, name: str = "shader.frag", stage: str | None = None
     output = (proc.stdout + proc.stderr).replace(path, name).strip()
     output = "\n".join(line for line in output.splitlines() if line.strip() != name)
     output = _locate(output, name, prelude)
-    return Verdict(proc.returncode == 0, "glslangValidator", output)
+    tool = "glslangValidator"
+    if stage != "frag" or kind == "plain":
+        tool += f", {stage} stage"
+    if kind == "plain":
+        tool += f", no #version: checked as {PLAIN_GLSL_VERSION}"
+    return Verdict(proc.returncode == 0, tool, output)
 
 
-def _library_prefix(text: str) -> str:
-    match = re.search(r"\bbool\s+(\w*)intersect\s*\(", text)
-    return match.group(1) if match else ""
+def _library_prefix(text: str) -> str | None:
+    """The prefix of an implc library emit's entry points (what the harness calls), or
+    None when `text` does not define them all (a user's own GLSL)."""
+    for match in re.finditer(r"\bbool\s+(\w*)intersect\s*\(", text):
+        prefix = re.escape(match.group(1))
+        if all(re.search(pattern, text) for pattern in (
+                rf"\bfloat\s+{prefix}S\s*\(", rf"\bvec3\s+{prefix}grad\s*\(",
+                rf"\bvec3\s+{prefix}shade\s*\(")):
+            return match.group(1)
+    return None
 
 
 def _locate(output: str, name: str, prelude: int) -> str:
@@ -167,8 +213,15 @@ def validate_file(path: Path) -> Verdict:
     return validate_text(path.read_text(encoding="utf-8"), target.name, str(path))
 
 
-def validate_text(text: str, target: str, name: str) -> Verdict:
-    """Validate `text` in the language of `target`; `name` is used in the messages."""
+def validate_text(text: str, target: str, name: str, stage: str | None = None) -> Verdict:
+    """Validate `text` in the language of `target`; `name` is used in the messages;
+    `stage` (GLSL only) overrides the stage `name`'s extension gives."""
     if target not in TARGETS:
         raise ToolError(f"no validator for target '{target}'")
-    return resolve(TARGETS[target].validator)(text, name)
+    check_source(text, name)
+    validator = resolve(TARGETS[target].validator)
+    if stage is None:
+        return validator(text, name)
+    if target != "glsl":
+        raise ValueError(f"a {target} shader has no stage to choose")
+    return validator(text, name, stage=stage)

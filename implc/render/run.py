@@ -145,11 +145,12 @@ def metadata(
 def render_surface(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
     output: Path, params: str = "constant",
-) -> tuple[list[Path], dict[str, float]]:
-    """Render and write the outputs; the paths written and the timing (see `render`)."""
+) -> tuple[list[Path], RenderResult]:
+    """Render and write the outputs; the paths written and the frame (its `timing`: see
+    `render`; its hits: what `implc render` reports)."""
     from .image_io import write_render
 
     result = render(surface, backend, method, constants, width, height, params)
     paths = write_render(result, output,
                          metadata(surface, backend, method, constants, result, params))
-    return paths, result.timing
+    return paths, result

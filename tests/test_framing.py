@@ -1,0 +1,288 @@
+"""Issue 23, points 1-3: a render that shows the surface, or says why not.
+
+A surface given without a view (`-e`, or a file whose [view] sets neither `radius` nor
+`eye`) is framed automatically (implc/extent.py finds it, implc/scene.py `apply_view`
+places the clip sphere and the camera); `--radius --center --eye --look-at --up
+--fov` override the file's [view]; a render prints its hit fraction and warns when nothing is
+hit or when the surface reaches the clip sphere. Renders here use the CPU reference at
+a few dozen pixels (no GPU needed).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy
+
+from implc.scene import View, camera_basis
+from implc.surface import example_paths, load_surface
+
+# the framing API (new with issue 23), imported per test so that the command-line tests
+# below run, and fail, against a tree without it
+
+
+def locate_surface(*args, **kwargs):
+    from implc.extent import locate_surface
+
+    return locate_surface(*args, **kwargs)
+
+
+def crosses_sphere(*args, **kwargs):
+    from implc.extent import crosses_sphere
+
+    return crosses_sphere(*args, **kwargs)
+
+
+def apply_view(*args, **kwargs):
+    from implc.scene import apply_view
+
+    return apply_view(*args, **kwargs)
+
+
+def ViewOptions(**kwargs):  # noqa: N802 (the class, imported late)
+    from implc.scene import ViewOptions
+
+    return ViewOptions(**kwargs)
+
+
+def frame_direction(up):
+    from implc.scene import frame_direction
+
+    return frame_direction(up)
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def implc(*args: str):
+    return subprocess.run(
+        [sys.executable, "-m", "implc", *args], capture_output=True, text=True, cwd=ROOT,
+        timeout=300, env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
+
+
+def render(tmp_path: Path, *args: str, size: int = 32):
+    out = tmp_path / "a.png"
+    proc = implc("render", *args, "-b", "reference", "--size", str(size), "-o", str(out))
+    assert "Traceback" not in proc.stderr, proc.stderr
+    sidecar = json.loads(out.with_suffix(".json").read_text()) if out.exists() else None
+    return proc, sidecar
+
+
+def hit_percent(stderr: str) -> float:
+    match = re.search(r"rendered \d+x\d+ .*; ([\d.]+) % of pixels hit", stderr)
+    assert match, stderr
+    return float(match.group(1))
+
+
+def expr(text: str) -> sympy.Expr:
+    return load_surface(equation=text).expr
+
+
+# --- point 1: the extent search ------------------------------------------------------------
+
+def test_a_sphere_of_radius_3_is_found_with_a_margin():
+    extent = locate_surface(expr("x^2+y^2+z^2-9"))
+    assert extent is not None and extent.bounded
+    assert extent.center == (0.0, 0.0, 0.0)
+    assert extent.radius == pytest.approx(3.3)
+
+
+def test_an_offset_small_surface_is_centred_on_itself():
+    extent = locate_surface(expr("(x-5)^2 + y^2 + (z+2)^2 - 0.25"))
+    assert extent is not None and extent.bounded
+    assert extent.center == pytest.approx((5.0, 0.0, -2.0))
+    assert 0.5 < extent.radius < 0.6
+
+
+def test_a_tiny_surface_is_found_by_the_small_cubes():
+    extent = locate_surface(expr("x^2+y^2+z^2-0.0001"))
+    assert extent is not None and extent.bounded
+    assert 0.01 < extent.radius <= 0.012
+
+
+def test_an_unbounded_surface_shows_the_part_near_the_origin():
+    extent = locate_surface(expr("z - x*y"))
+    assert extent is not None and not extent.bounded
+    assert extent.center == (0.0, 0.0, 0.0) and extent.radius == 2.0
+
+
+def test_no_real_surface_is_no_extent():
+    assert locate_surface(expr("x^2+y^2+z^2+1")) is None
+
+
+def test_a_given_centre_keeps_its_place():
+    extent = locate_surface(expr("x^2+y^2+z^2-1"), center=(0.5, 0.0, 0.0))
+    assert extent is not None and extent.center == (0.5, 0.0, 0.0)
+    assert 1.5 <= extent.radius <= 1.7
+
+
+# --- point 1: the framing rule -------------------------------------------------------------
+
+def test_bundled_examples_keep_their_views():
+    """Every bundled file sets `radius`: nothing is searched, nothing moves (goldens)."""
+    def locate(center):
+        raise AssertionError("a bundled example is not searched")
+
+    for name in example_paths():
+        view = load_surface(name).view
+        framed, framing = apply_view(view, ViewOptions(), locate)
+        assert framed == view and framing is None, name
+
+
+def test_a_view_without_radius_or_eye_is_framed():
+    sphere = expr("x^2+y^2+z^2-9")
+    framed, framing = apply_view(View(), ViewOptions(), lambda c: locate_surface(sphere))
+    assert framing is not None and framing.placed_eye
+    assert framed.clip_radius == pytest.approx(3.3) and framed.target == (0.0, 0.0, 0.0)
+    forward = -np.asarray(framed.eye) / np.linalg.norm(framed.eye)
+    assert np.allclose(-forward, np.array([3.0, 2.0, 4.0]) / math.sqrt(29.0))
+    # the sphere fills 90 % of the picture's height
+    half = math.asin(3.3 / np.linalg.norm(framed.eye))
+    assert math.tan(half) == pytest.approx(0.9 * math.tan(math.radians(15.0)))
+
+
+def test_command_line_radius_overrides_and_places_the_eye():
+    framed, framing = apply_view(View(), ViewOptions(radius=4.0), lambda c: pytest.fail("searched"))
+    assert framed.clip_radius == 4.0 and framing is not None and framing.placed_eye
+
+
+def test_a_file_radius_without_eye_keeps_the_default_eye():
+    view = View(clip_radius=1.2, given=frozenset({"radius"}))
+    assert apply_view(view, ViewOptions(), lambda c: pytest.fail("searched")) == (view, None)
+
+
+def test_command_line_options_override_the_file(tmp_path):
+    surface = tmp_path / "s.toml"
+    surface.write_text('equation = "x^2+y^2+z^2-1"\n[view]\nradius = 0.1\neye = [3, 2, 4]\n')
+    proc, car = render(tmp_path, str(surface), "--radius", "1.5", "--center=0,0,0",
+                       "--eye", "0,-6,0", "--look-at", "0,0,0", "--up", "z", "--fov", "35")
+    assert proc.returncode == 0, proc.stderr
+    assert car["clip"] == {"center": [0.0, 0.0, 0.0], "radius": 1.5}
+    cam = car["camera"]
+    assert (cam["eye"], cam["up"], cam["fov_y_deg"]) == ([0.0, -6.0, 0.0], [0.0, 0.0, 1.0], 35.0)
+    assert hit_percent(proc.stderr) > 10.0
+
+
+def test_negative_coordinates_need_no_equals_sign(tmp_path):
+    proc, car = render(tmp_path, "-e", "x^2+y^2+z^2-1", "--eye", "-5,-1,-2", "--up", "-y")
+    assert proc.returncode == 0, proc.stderr
+    assert car["camera"]["eye"] == [-5.0, -1.0, -2.0] and car["camera"]["up"] == [0, -1, 0]
+
+
+@pytest.mark.parametrize("option", [
+    ("--radius", "0"), ("--radius", "-2"), ("--radius", "nan"), ("--center", "1,2"),
+    ("--eye", "1,2,x"), ("--look-at", "inf,0,0"), ("--up", "w"), ("--up", "0,0,0"),
+    ("--fov", "180"), ("--fov", "0"), ("--eye", "1e7,0,0"),
+])
+def test_bad_view_options_are_usage_errors(option, tmp_path):
+    proc = implc("render", "-e", "x^2+y^2+z^2-1", *option, "-o", str(tmp_path / "a.png"))
+    assert proc.returncode == 2, proc.stderr
+    assert option[0] in proc.stderr and "Traceback" not in proc.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_view_the_options_break_is_a_usage_error(tmp_path):
+    """The file's eye looks along -y... and --up y is parallel to it."""
+    surface = tmp_path / "s.toml"
+    surface.write_text('equation = "x^2+y^2+z^2-1"\n[view]\neye = [0, 5, 0]\nup = [0, 0, 1]\n')
+    proc = implc("render", str(surface), "--up", "y", "-o", str(tmp_path / "a.png"))
+    assert proc.returncode == 2
+    assert "up = [0, 1, 0] is parallel to the view direction" in proc.stderr
+    assert not (tmp_path / "a.png").exists()
+
+
+def test_big_sphere_from_the_issue_is_framed_and_hit(tmp_path):
+    proc, car = render(tmp_path, "-e", "x^2+y^2+z^2-9")
+    assert proc.returncode == 0, proc.stderr
+    assert "framed: center (0, 0, 0), radius 3.3" in proc.stderr
+    assert car["clip"]["radius"] == pytest.approx(3.3)
+    assert hit_percent(proc.stderr) > 30.0
+    assert "warning" not in proc.stderr
+
+
+def test_no_real_surface_says_so_and_warns(tmp_path):
+    proc, car = render(tmp_path, "-e", "x^2+y^2+z^2+1")
+    assert proc.returncode == 0
+    assert "no surface found in |x|,|y|,|z| <= 2048" in proc.stderr
+    assert car["clip"]["radius"] == 1.5  # the default view is kept
+    assert hit_percent(proc.stderr) == 0.0
+    assert "warning: no pixel hits the surface" in proc.stderr
+
+
+def test_a_clip_sphere_too_small_warns_with_a_radius_that_works(tmp_path):
+    surface = tmp_path / "s.toml"
+    surface.write_text('equation = "x^2+y^2+z^2-1"\n[view]\nradius = 0.1\n')
+    proc, _ = render(tmp_path, str(surface))
+    assert proc.returncode == 0
+    assert hit_percent(proc.stderr) == 0.0
+    warning = [ln for ln in proc.stderr.splitlines() if "warning" in ln]
+    assert len(warning) == 1, proc.stderr
+    assert "no pixel hits the surface" in warning[0] and "--radius 1.1" in warning[0]
+
+
+def test_compile_and_view_take_the_view_options(tmp_path):
+    proc = implc("compile", "-e", "x^2+y^2+z^2-1", "--eye", "0,0,9", "--flavor", "shadertoy")
+    assert proc.returncode == 0, proc.stderr
+    assert "vec3 eye = vec3(0.0, 0.0, 9.0);" in proc.stdout
+    page = tmp_path / "p.html"
+    proc = implc("view", "-e", "x^2+y^2+z^2-9", "--no-webgpu", "-o", str(page))
+    assert proc.returncode == 0, proc.stderr
+    assert "framed: center (0, 0, 0), radius 3.3" in proc.stderr
+    assert '"clip_radius": 3.3' in page.read_text()
+
+
+# --- point 2: which way is up --------------------------------------------------------------
+
+def test_help_says_which_way_is_up():
+    for command in ("render", "view", "compile"):
+        text = " ".join(implc(command, "--help").stdout.split())
+        assert "--up" in text and "+y is up" in text and "--up z" in text, command
+
+
+def test_frame_direction_turns_with_up():
+    assert np.allclose(frame_direction((0.0, 1.0, 0.0)) * math.sqrt(29), (3, 2, 4))
+    assert np.allclose(frame_direction((0.0, 0.0, 1.0)) * math.sqrt(29), (3, -4, 2))
+    assert np.allclose(frame_direction((0.0, 0.0, 2.0)) * math.sqrt(29), (3, -4, 2))
+
+
+def test_the_heart_stands_up_with_up_z(tmp_path):
+    heart = "(x^2 + 9/4 y^2 + z^2 - 1)^3 - x^2z^3 - 9/80 y^2z^3"
+    proc, car = render(tmp_path, "-e", heart, "--up", "z")
+    assert proc.returncode == 0, proc.stderr
+    view = View(eye=tuple(car["camera"]["eye"]), target=tuple(car["camera"]["target"]),
+                up=tuple(car["camera"]["up"]))
+    assert camera_basis(view)[2][2] > 0.8  # the picture's up is mostly +z
+    assert hit_percent(proc.stderr) > 20.0
+
+
+# --- point 3: a clipped surface is said to be clipped --------------------------------------
+
+def test_crosses_sphere():
+    sphere = expr("x^2+y^2+z^2-1")
+    assert crosses_sphere(sphere, (0.0, 0.0, 0.0), 0.9) is False
+    assert crosses_sphere(sphere, (0.0, 0.0, 0.0), 1.2) is False
+    assert crosses_sphere(sphere, (1.0, 0.0, 0.0), 0.5) is True
+
+
+def test_a_torus_cut_by_the_clip_sphere_warns(tmp_path):
+    proc, _ = render(tmp_path, "torus", "--param", "r=0.6")
+    assert proc.returncode == 0
+    warning = [ln for ln in proc.stderr.splitlines() if "warning" in ln]
+    assert len(warning) == 1, proc.stderr
+    assert "reaches the clip sphere" in warning[0] and "radius 1.45" in warning[0]
+    assert "--radius 1.8 holds all of it" in warning[0]
+
+
+def test_the_bundled_torus_is_not_clipped(tmp_path):
+    proc, _ = render(tmp_path, "torus")
+    assert proc.returncode == 0
+    assert "clip sphere" not in proc.stderr and "warning" not in proc.stderr
+    assert hit_percent(proc.stderr) > 10.0
