@@ -145,8 +145,12 @@ def _load_toml(
         first = raw[:200].split(b"\n")[0].decode("utf-8", "replace")
         raise InputError(f"file is larger than {MAX_FILE_BYTES} bytes",
                          Source(name, first, 1, 1), 0, 1)
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise InputError("not UTF-8 text: the file is UTF-16 (it starts with a byte order "
+                         "mark); save it as UTF-8", Source(name, "", 1, 1))
     try:
-        text = raw.decode("utf-8")
+        # a byte order mark (Notepad's "UTF-8 with BOM") is not part of the text
+        text = raw.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as err:
         before = raw[: err.start]
         line = before.count(b"\n") + 1

@@ -392,3 +392,37 @@ def test_exit_codes_are_documented():
     for name in ("EXIT_OK", "EXIT_INPUT", "EXIT_USAGE", "EXIT_INVALID", "EXIT_TOOL",
                  "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_TERMINATED"):
         assert f"| {getattr(errors, name)} |" in table, name
+
+
+# --------------------------------------------------------------------------- issue 23
+
+
+def test_a_surface_file_with_a_bom_and_crlf_loads(tmp_path):
+    """Notepad's UTF-8 (a byte order mark, CRLF line ends) was "invalid TOML: invalid
+    statement" showing `?equation` (issue 23, point 18)."""
+    surface = tmp_path / "s.toml"
+    surface.write_bytes(b'\xef\xbb\xbfname = "s"\r\nequation = "x^2 + y^2 + z^2 - a"\r\n'
+                        b"[params]\r\na = 2\r\n[view]\r\nradius = 2\r\n")
+    proc = implc("show", str(surface))
+    assert proc.returncode == 0, proc.stderr
+    assert "surface:   s (" in proc.stdout
+
+
+def test_errors_in_a_bom_crlf_file_with_tabs_are_located(tmp_path):
+    surface = tmp_path / "s.toml"
+    surface.write_bytes(b'\xef\xbb\xbfname = "s"\r\nequation = "x^2 +\ty^2 + @"\r\n')
+    proc = implc("show", str(surface))
+    assert proc.returncode == 1
+    header, shown, caret = proc.stderr.splitlines()
+    assert header == f"{surface}:2:25: error: unexpected character '@'"
+    assert shown == '  equation = "x^2 +    y^2 + @"'  # the tab as spaces, no '\r' shown
+    assert caret.index("^") == shown.index("@")
+
+
+def test_a_utf16_surface_file_is_named(tmp_path):
+    surface = tmp_path / "s.toml"
+    surface.write_bytes('equation = "x^2 + y^2 + z^2 - 1"\n'.encode("utf-16"))
+    proc = implc("show", str(surface))
+    assert proc.returncode == 1
+    assert proc.stderr.startswith(f"{surface}:1:1: error: not UTF-8 text: the file is UTF-16 "
+                                  "(it starts with a byte order mark); save it as UTF-8")
