@@ -13,7 +13,24 @@ class _EquationPrinter(StrPrinter):
         name = _NAMES.get(type(expr).__name__, type(expr).__name__)
         return f"{name}({', '.join(self._print(a) for a in expr.args)})"
 
-    _print_Abs = _print_Min = _print_Max = _print_Function
+    _print_Abs = _print_Function
+
+    def _print_Min(self, expr):
+        """min(a, b, c) as written: the parser builds it as min(min(a, b), c)
+        (parse._call_expr); min and max are associative, so flattening prints the same
+        function."""
+        args, stack = [], list(reversed(expr.args))
+        while stack:
+            arg = stack.pop()
+            if type(arg) is type(expr):
+                stack.extend(reversed(arg.args))
+            else:
+                args.append(arg)
+        name = _NAMES[type(expr).__name__]
+        args.sort(key=sympy.default_sort_key)  # sympy's order of a flat min (x before y)
+        return f"{name}({', '.join(self._print(a) for a in args)})"
+
+    _print_Max = _print_Min
 
     def _print_Rational(self, expr):
         """Short fractions stay exact (`9/4`); long ones (from decimal parameters such as

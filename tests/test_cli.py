@@ -426,3 +426,32 @@ def test_a_utf16_surface_file_is_named(tmp_path):
     assert proc.returncode == 1
     assert proc.stderr.startswith(f"{surface}:1:1: error: not UTF-8 text: the file is UTF-16 "
                                   "(it starts with a byte order mark); save it as UTF-8")
+
+
+def test_an_nary_max_compiles_validates_and_renders(tmp_path):
+    """A cube as users write it, max of three (issue 23, point 17): it compiles to a
+    shader its compiler accepts, for the default method and for hessian (derivatives by
+    branch), and renders like the CPU reference."""
+    require_tool("glslangValidator")
+    cube = "max(abs(x), abs(y), abs(z)) - 0.8"
+    for method in ("interval", "hessian"):
+        out = tmp_path / f"{method}.frag"
+        proc = implc("compile", "-e", cube, "-m", method, "--validate", "-o", str(out))
+        assert proc.returncode == 0, proc.stderr
+        assert "// Equation: max(abs(x), abs(y), abs(z)) - 4/5 = 0" in out.read_text()
+    from conftest import require_gl
+
+    require_gl()
+    images = {}
+    for backend in ("gl", "reference"):
+        images[backend] = tmp_path / f"{backend}.png"
+        proc = implc("render", "-e", cube, "-b", backend, "--size", "48",
+                     "-o", str(images[backend]))
+        assert proc.returncode == 0, proc.stderr
+    import numpy as np
+    from PIL import Image
+
+    gl, ref = (np.asarray(Image.open(images[b]).convert("L"), dtype=float) for b in images)
+    background = ref[0, 0]
+    assert (ref != background).mean() > 0.2  # the cube fills much of the frame
+    assert ((gl != background) != (ref != background)).mean() < 0.02

@@ -208,7 +208,10 @@ def test_every_user_function_parses_with_its_arity(name: str) -> None:
     point = {X: 0.3, Y: 0.7, Z: 0.2}
     expected = function.numpy(*(point[s] for s in (X, Y, Z)[: function.arity]))
     assert float(result.subs(point).evalf()) == pytest.approx(float(expected))
-    if function.arity > 1:
+    if function.variadic:
+        with pytest.raises(InputError, match=f"{name} takes 2 or more arguments, got 1"):
+            parse(f"{name}(x)")
+    elif function.arity > 1:
         with pytest.raises(InputError, match=f"{name} takes {function.arity} arguments, got 1"):
             parse(f"{name}(x)")
     else:
@@ -220,6 +223,28 @@ def test_min_and_max_stay_as_written() -> None:
     result = parse("min(x, min(y, z))")
     assert isinstance(result, sympy.Min)
     assert result.args == (X, sympy.Min(Y, Z, evaluate=False))
+
+
+@pytest.mark.parametrize("count", [3, 4, 7])
+def test_min_and_max_take_more_arguments(count: int) -> None:
+    """`max(abs(x), abs(y), abs(z))` was "max takes 2 arguments, got 3" (issue 23, point
+    17): users write CSG so. Built as a balanced tree of two-argument calls (what printers
+    fold them into; sympy differentiates a flat Max of n through Max of the n - 1 others,
+    comparing them pairwise), printed flat again."""
+    from implc.numeric import evaluate
+    from implc.textform import to_text
+
+    terms = [f"{k}x - y^2 + sin({k}z)" for k in range(1, count + 1)]
+    for name, pick in (("max", max), ("min", min)):
+        result = parse(f"{name}({', '.join(terms)})")
+        calls = result.atoms(sympy.Max if name == "max" else sympy.Min)
+        assert len(calls) == count - 1 and all(len(c.args) == 2 for c in calls)
+        point = {X: 0.3, Y: -0.4, Z: 0.8}
+        values = [float(evaluate(parse(t), point)) for t in terms]
+        assert float(evaluate(result, point)) == pytest.approx(pick(values))
+        printed = to_text(result)
+        assert printed.startswith(f"{name}(") and printed.count(f"{name}(") == 1, printed
+        assert same(printed, result)
 
 
 def test_nested_min_is_built_unevaluated() -> None:
