@@ -72,8 +72,8 @@ from implc.errors import InputError, LimitError, Source
 from implc.functions import CONSTANTS, USER_FUNCTIONS, Function
 from implc.symbols import X, Y, Z
 
-__all__ = ["Limits", "check_param_name", "fold_constants", "param_symbol", "parse_equation",
-           "parse_equation_with_params", "parse_number"]
+__all__ = ["Limits", "check_param_name", "fold_constants", "param_symbol", "parse_constant",
+           "parse_equation", "parse_equation_with_params", "parse_number"]
 
 
 @dataclass(frozen=True)
@@ -237,8 +237,37 @@ def param_symbol(name: str) -> sympy.Symbol:
     return sympy.Symbol(name, real=True)
 
 
+def parse_constant(
+    source: Source,
+    limits: Limits = Limits(),  # noqa: B008 - frozen, so a shared default is safe
+) -> sympy.Expr:
+    """A parameter's value (`--param phi=(1+sqrt(5))/2`): a number or a constant
+    expression of the equation language, read by the same parser with the same checks.
+
+    Exact: a rational stays a `Rational` (`0.1` is 1/10), anything else the sympy
+    expression as written (`1/2 + sqrt(5)/2`; the equation folds it like an inline
+    constant). Raises `InputError` located in `source` for x, y, z, `=`, a non-real or
+    non-finite value and everything `parse_equation` refuses.
+    """
+    text = source.text
+    stripped = text.strip(_WHITESPACE)
+    lead = len(text) - len(text.lstrip(_WHITESPACE))
+    if not stripped:
+        raise InputError("empty number", source, 0, max(1, len(text)))
+    if stripped.lstrip("+-").lower() in ("nan", "inf", "infinity"):
+        raise InputError(f"number must be finite, got {_quote(stripped)}", source, lead,
+                         len(stripped))
+    if re.fullmatch(r"[+-]?0[xXoObB]\w*", stripped):  # not 0 times the name x10
+        raise InputError(f"invalid number {_quote(stripped)}", source, lead, len(stripped))
+    value = _parse(source, None, limits, keep_params=False, constant=True)[0]
+    if value.has(sympy.Min, sympy.Max):  # built unevaluated; of numbers, cheap to evaluate
+        value = value.doit()
+    return value
+
+
 def _parse(
-    source: Source, params: Mapping[str, sympy.Expr] | None, limits: Limits, keep_params: bool
+    source: Source, params: Mapping[str, sympy.Expr] | None, limits: Limits, keep_params: bool,
+    constant: bool = False,
 ) -> tuple[sympy.Expr, sympy.Expr | None]:
     text = source.text
     if len(text) > limits.max_chars:
@@ -254,10 +283,12 @@ def _parse(
     values = _param_values(params or {})
     try:
         tokens = _tokenize(text, values)
-        root = _Parser(source, tokens, values, limits).parse()
+        root = _Parser(source, tokens, values, limits, constant).parse()
         info = _Analyzer(source, values, limits).analyze(root)
         builder = _Builder(source, values, info, limits)
-        expr = builder.build(root)
+        expr = builder.build(root, constant)
+        if constant:
+            return expr, None
         folded = fold_constants(expr)
         if not keep_params:
             return folded, None
@@ -776,11 +807,13 @@ class _Parser:
         tokens: list[_Token],
         params: Mapping[str, object],
         limits: Limits,
+        constant: bool = False,
     ):
         self.source = source
         self.tokens = tokens
         self.params = params
         self.limits = limits
+        self.constant = constant  # a parameter's value (parse_constant), not an equation
         self.pos = 0
         self.prev: _Token | None = None
         self.depth = 0
@@ -827,6 +860,8 @@ class _Parser:
         if not token.is_op("="):
             self.expect_end(token)
             return lhs
+        if self.constant:
+            raise self.error_at("a value has no '='", token)
         equals = self.advance()
         self.seen_equals = True
         if self.peek().kind == "end":
@@ -1047,7 +1082,10 @@ class _Parser:
                 shown.append(f"{len(uses) - len(names)} more")
             message = f"unknown names {', '.join(shown[:-1])} and {shown[-1]}"
         help_text = None
-        if free:
+        if self.constant:
+            help_text = ("a parameter's value is a number or a constant expression, like "
+                         "(1 + sqrt(5))/2")
+        elif free:
             given = " ".join(f"--param {name}=VALUE" for name in free)
             help_text = (f"give {'its value' if len(free) == 1 else 'their values'} with "
                          f"{given} (in a surface file: under [params])")
@@ -1450,10 +1488,14 @@ class _Builder:
     def fail(self, message: str, node: _Node) -> InputError:
         return InputError(message, self.source, node.start, node.end - node.start)
 
-    def build(self, root: _Node) -> sympy.Expr:
+    def build(self, root: _Node, constant: bool = False) -> sympy.Expr:
+        """The expression of `root`; with `constant`, of a value (no x, y, z)."""
         built: dict[_Node, sympy.Expr] = {}
         self.built = built  # every node's expression (the symbolic build reuses them)
         order = _postorder(root)
+        variable = next((n for n in order if isinstance(n, _Var)), None)
+        if constant and variable is not None:
+            raise self.fail("a value must not depend on x, y or z", variable)
         for node in order:
             built[node] = self.make(node, built)
             info = self.info[node]
@@ -1469,7 +1511,7 @@ class _Builder:
         if result.has(*(atom for atom, _ in _NON_REAL_MESSAGES)):
             raise self.locate_non_real(order, built)
         self.check_numbers(order, built)
-        if not result.free_symbols & {X, Y, Z}:
+        if not constant and not result.free_symbols & {X, Y, Z}:
             raise self.fail("equation does not depend on x, y or z", root)
         return result
 

@@ -64,4 +64,10 @@ class _EquationPrinter(StrPrinter):
 
 def to_text(expr: sympy.Expr) -> str:
     """`expr` as `... = 0` in implc's input language (deterministic, `^` for powers)."""
-    return _EquationPrinter({"order": "lex"}).doprint(expr) + " = 0"
+    return value_text(expr) + " = 0"
+
+
+def value_text(expr: sympy.Expr) -> str:
+    """`expr` in implc's input language: a parameter's value (`7/20`, `1.618033988749895`
+    for a long decimal, `1/2 + sqrt(5)/2`)."""
+    return _EquationPrinter({"order": "lex"}).doprint(expr)

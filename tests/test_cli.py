@@ -455,3 +455,47 @@ def test_an_nary_max_compiles_validates_and_renders(tmp_path):
     background = ref[0, 0]
     assert (ref != background).mean() > 0.2  # the cube fills much of the frame
     assert ((gl != background) != (ref != background)).mean() < 0.02
+
+
+def test_a_parameter_value_may_be_a_constant_expression(tmp_path):
+    """`--param "phi=(1+sqrt(5))/2"` was "invalid number" with the caret under the value
+    alone (issue 23, point 12): the equation parser reads it; an error echoes the whole
+    argument with the caret under the fault."""
+    proc = implc("show", "-e", "x^2 + y^2 + z^2 - phi", "--param", "phi=(1+sqrt(5))/2")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines()[1:3] == [
+        "equation:  -phi + x^2 + y^2 + z^2 = 0",
+        "           with phi = 1/2 + sqrt(5)/2: x^2 + y^2 + z^2 - 1.618033988749895 = 0",
+    ]
+    proc = implc("show", "-e", "x^2 + y^2 + z^2 - phi", "--param", "phi = (1+sqrt(5)/2")
+    assert proc.returncode == 1
+    assert proc.stderr.splitlines() == [
+        "--param:1:7: error: unclosed '('",
+        "  phi = (1+sqrt(5)/2",
+        "        ^",
+    ]
+
+
+def test_list_and_show_print_the_equation_with_its_parameter_names():
+    """`list` and `show` printed `2.6180339887498953*z^2` for `phi^2` and `351/400` for
+    `R^2 - r^2` (issue 23, point 16): the equation with the names, then the values and
+    the substituted form below it."""
+    proc = implc("list")
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    torus = next(i for i, line in enumerate(lines) if line.startswith("torus "))
+    assert lines[torus].endswith(" -4*R^2*(x^2 + y^2) + (R^2 - r^2 + x^2 + y^2 + z^2)^2 = 0")
+    assert lines[torus + 1].strip() == ("with R = 1, r = 7/20: -4*x^2 - 4*y^2 + "
+                                        "(x^2 + y^2 + z^2 + 351/400)^2 = 0")
+    barth = next(line for line in lines if line.startswith("barth-sextic "))
+    assert "phi^2*x^2" in barth and "2.618" not in barth
+    roman = lines.index(next(line for line in lines if line.startswith("roman ")))
+    assert not lines[roman + 1].startswith(" ")  # no parameters: one line
+    proc = implc("show", "barth-sextic")
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout.splitlines()
+    assert out[1].startswith("equation:  ") and "4*(phi^2*x^2 - y^2)" in out[1]
+    assert "2.618" not in out[1]
+    assert out[2].startswith("           with phi = 1.618033988749895: 4*(")
+    assert "2.6180339887498953*x^2" in out[2]
+    assert "params:    phi = 1.618033988749895" in proc.stdout

@@ -19,6 +19,7 @@ from implc.parse import (
     check_param_name,
     fold_constants,
     param_symbol,
+    parse_constant,
     parse_equation,
     parse_equation_with_params,
     parse_number,
@@ -559,6 +560,57 @@ def test_parse_number_points_into_its_source() -> None:
     with pytest.raises(InputError) as caught:
         parse_number(" 0.5.1", Source("--param", " 0.5.1", col=9))
     assert caught.value.render().startswith("--param:1:10: error: invalid number '0.5.1'")
+
+
+# --------------------------------------------------------------------------- parse_constant
+
+
+@pytest.mark.parametrize(
+    ("text", "value"),
+    [
+        ("(1+sqrt(5))/2", (1 + sympy.sqrt(5)) / 2),
+        ("2pi/3", 2 * sympy.pi / 3),
+        ("0.1", sympy.Rational(1, 10)),
+        (" -2 ", sympy.Integer(-2)),
+        ("1 / -4", sympy.Rational(-1, 4)),
+        ("2^-3", sympy.Rational(1, 8)),
+        ("e^2", sympy.E**2),
+        ("max(1, 2, 3/2)", sympy.Integer(2)),
+        (repr(0.5067166090011597), sympy.Rational(5067166090011597, 10**16)),
+    ],
+)
+def test_parse_constant(text: str, value: sympy.Expr) -> None:
+    """A parameter's value may be a constant expression, read by the equation parser
+    (`--param "phi=(1+sqrt(5))/2"` was "invalid number"; issue 23, point 12); exact."""
+    result = parse_constant(Source("--param", text))
+    assert sympy.simplify(result - value) == 0
+    assert result.is_Rational == value.is_Rational
+
+
+@pytest.mark.parametrize(
+    ("text", "message", "column"),
+    [
+        ("x/2", "a value must not depend on x, y or z", 1),
+        ("1 = 2", "a value has no '='", 3),
+        ("sqrt(-1)", "value is not a real number", 1),
+        ("log(0)", "value is infinite", 1),
+        ("1/(2 - 2)", "division by zero", 3),
+        ("(1+sqrt(5)/2", "unclosed '('", 1),
+        ("nan", "number must be finite, got 'nan'", 1),
+        ("-inf", "number must be finite, got '-inf'", 1),
+        ("0x10", "invalid number '0x10'", 1),
+        ("", "empty number", 1),
+        ("abc", "unknown name 'abc'", 1),
+        ("9^9^9", "too complex: constant power exceeds the limit of 300 digits", 1),
+        ("1e400", "too complex: number '1e400' exceeds the limit of 1e30", 1),
+        ("__import__('os')", "unknown function '__import__'", 1),
+    ],
+)
+def test_parse_constant_rejects(text: str, message: str, column: int) -> None:
+    with pytest.raises(InputError) as caught:
+        parse_constant(Source("--param", text))
+    assert caught.value.message.startswith(message)
+    assert caught.value.render().startswith(f"--param:1:{column}: error: ")
 
 
 # --------------------------------------------------------------------------- check_param_name
