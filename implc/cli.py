@@ -611,7 +611,10 @@ def cmd_list(args) -> int:
         surface = load_surface(name)
         degree = polynomial_degree(surface.expr)
         kind = f"deg {degree}" if degree else "non-poly"
-        print(f"{name:<18} {kind:<9} {surface.equation}")
+        equation, *substituted = surface.equation_lines()  # names, then values if any
+        print(f"{name:<18} {kind:<9} {equation}")
+        for line in substituted:
+            print(f"{'':<28} {line}")
     return EXIT_OK
 
 

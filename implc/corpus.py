@@ -157,10 +157,11 @@ def row_surface(row: Row, limits=None):
     try:
         return load_surface(equation=row.equation, params=args, limits=limits)
     except InputError as err:
-        free = re.fullmatch(r"unknown name '(\w+)'.*", err.message)
-        if free and free.group(1) in row.free_params:
-            err.message = (f"unknown name '{free.group(1)}': a free parameter upstream, "
-                           "with no value in the corpus")
+        names = re.findall(r"'(\w+)'", err.message)
+        if (err.message.startswith("unknown name") and names
+                and all(name in row.free_params for name in names)):
+            what = "a free parameter" if len(names) == 1 else "free parameters"
+            err.message = f"{err.message}: {what} upstream, with no value in the corpus"
             err.args = (err.message,)
         raise
 
@@ -432,8 +433,9 @@ def figures(results: Sequence[RowResult], targets: Sequence[str] = TARGETS) -> F
 _CATEGORIES: tuple[tuple[str, str], ...] = (
     (r"unknown function ", "unknown function (a helper defined in upstream code, not in "
                            "implc's function table)"),
-    (r"unknown name '\w+': a free parameter", "free parameter without a value in the corpus"),
-    (r"unknown name ", "unknown name (a helper variable defined in upstream code)"),
+    (r"unknown names? .*: (a free parameter|free parameters) upstream",
+     "free parameter without a value in the corpus"),
+    (r"unknown names? ", "unknown name (a helper variable defined in upstream code)"),
     (r"too complex: degree ", "degree over the limit (--max-degree)"),
     (r"too complex: exponent ", "integer exponent over the limit (--max-exponent)"),
     (r"too complex: derivatives ", "derivatives over the size limit (--max-derived)"),

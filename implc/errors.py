@@ -8,6 +8,7 @@ line and a caret under the span), even when the equation sits inside a TOML stri
 
 from __future__ import annotations
 
+import unicodedata
 from dataclasses import dataclass
 
 # Documented exit codes (README "Exit codes").
@@ -70,22 +71,39 @@ class InputError(ImplcError):
     """A mistake in user input, located at a span of its source when one is known."""
 
     def __init__(
-        self, message: str, source: Source | None = None, offset: int = 0, length: int = 1
+        self,
+        message: str,
+        source: Source | None = None,
+        offset: int = 0,
+        length: int = 1,
+        *,
+        also: tuple[tuple[int, int], ...] = (),
+        help: str | None = None,  # noqa: A002 - the word the printed line starts with
     ):
         super().__init__(message)
         self.message = message
         self.source = source
         self.offset = offset
         self.length = max(1, length)
+        # more (offset, length) spans of the same problem (every use of an unknown name):
+        # marked on the echoed line when they sit on it
+        self.also = also
+        # what to do about it, printed as a last line `help: ...`
+        self.help = help
 
     def render(self) -> str:
+        tail = f"\n  help: {self.help}" if self.help else ""
         if self.source is None:
-            return f"implc: error: {self.message}"
+            return f"implc: error: {self.message}{tail}"
         line, col, line_text, col_in_line = self.source.locate(self.offset)
-        shown = _printable(line_text)
-        caret_len = max(1, min(self.length, len(shown) - col_in_line))
-        caret = " " * col_in_line + "^" + "~" * (caret_len - 1)
-        return f"{self.source.name}:{line}:{col}: error: {self.message}\n  {shown}\n  {caret}"
+        spans = [(col_in_line, self.length)]
+        for offset, length in self.also:
+            other = self.source.locate(offset)
+            if other[0] == line and other[2] == line_text:
+                spans.append((other[3], length))
+        shown, marks = _excerpt(line_text, spans)
+        return (f"{self.source.name}:{line}:{col}: error: {self.message}\n  {shown}\n  {marks}"
+                f"{tail}")
 
 
 class OutputError(InputError):
@@ -109,6 +127,60 @@ class ToolError(ImplcError):
     exit_code = EXIT_TOOL
 
 
-def _printable(text: str) -> str:
-    """Show control characters as `?` so the caret stays under the right column."""
-    return "".join(ch if ch.isprintable() else "?" for ch in text)
+# Widest echoed source line, in terminal columns: a longer line is cut to a window around
+# the caret, with `...` where it was cut (a 60,000-character -e stays a few lines).
+WINDOW = 100
+_CUT = "..."
+_TAB = "    "  # a tab, shown as spaces (its width in a terminal depends on the column)
+
+
+def _cell(ch: str) -> str:
+    """How one character of an echoed line is shown: a tab as spaces, other control
+    characters as `?`, so that the caret line can be counted in characters."""
+    if ch == "\t":
+        return _TAB
+    return ch if ch.isprintable() else "?"
+
+
+def _width(shown: str) -> int:
+    """Terminal columns of a shown cell: 2 for wide (CJK, full-width) characters."""
+    if len(shown) == 1 and unicodedata.east_asian_width(shown) in ("W", "F"):
+        return 2
+    return len(shown)
+
+
+def _excerpt(text: str, spans: list[tuple[int, int]]) -> tuple[str, str]:
+    """The echoed line and the caret line under it (`^~~~` under each span), cut to a
+    window of about WINDOW columns around the first span when the line is longer."""
+    cells = [_cell(ch) for ch in text]
+    starts = [0]  # the column where each character starts, then the line's width
+    for cell in cells:
+        starts.append(starts[-1] + _width(cell))
+    total = starts[-1]
+
+    def columns(offset: int, length: int) -> tuple[int, int]:
+        offset = max(0, min(offset, len(text)))
+        end = min(offset + max(1, length), len(text))
+        return starts[offset], max(starts[offset] + 1, starts[end])
+
+    marked = [columns(offset, length) for offset, length in spans]
+    left, right = 0, total
+    if total > WINDOW:  # a third of the window before the caret, the rest after it
+        room = WINDOW - 2 * len(_CUT)
+        left = max(0, min(marked[0][0] - room // 3, total - room))
+        right = left + room
+    first = next(i for i, s in enumerate(starts) if s >= left)
+    last = max(i for i, s in enumerate(starts) if s <= right)
+    prefix = _CUT if first > 0 else ""
+    suffix = _CUT if last < len(text) else ""
+    shift = len(prefix) - starts[first]
+    text_end = len(prefix) + starts[last] - starts[first]
+    marks: list[str] = []
+    for start, end in reversed(marked):  # the first span last: it wins where they meet
+        start = start + shift  # a caret right after the text is fine: "missing ')'"
+        end = max(start + 1, min(end + shift, text_end))
+        if start < len(prefix) or start > text_end or (start == text_end and suffix):
+            continue  # outside the window
+        marks += [" "] * (end - len(marks))
+        marks[start:end] = ["^"] + ["~"] * (end - start - 1)
+    return prefix + "".join(cells[first:last]) + suffix, "".join(marks)

@@ -52,6 +52,8 @@ class Function:
     # how far a shader's value may lie from the exact one, widening the rule's bounds:
     # (units of float32's epsilon relative to the value, absolute); see implc/interval.py
     error: tuple[float, float] = (0.0, 0.0)
+    # takes `arity` or more arguments (min, max: users write CSG as max(a, b, c))
+    variadic: bool = False
 
 
 def _heaviside(x, *_):
@@ -156,8 +158,9 @@ FUNCTIONS: tuple[Function, ...] = (
     Function("sign", 1, sympy.sign, "sign", np.sign, "-1, 0 or 1; derivative 0",
              interval=lambda lo, hi, let: (sympy.sign(lo), sympy.sign(hi), sympy.false)),
     # min and max take their arguments' bounds apart (implc/interval.py)
-    Function("min", 2, sympy.Min, "Min", np.minimum, "smooth union in CSG; derivative by branch"),
-    Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch"),
+    Function("min", 2, sympy.Min, "Min", np.minimum, "smooth union in CSG; derivative by branch",
+             variadic=True),
+    Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch", variadic=True),
     # Only in derivatives: the step of min/max/abs and the (ignored) spike of sign.
     Function("step", 1, sympy.Heaviside, "Heaviside", _heaviside,
              "derivative of min/max; 1 for x > 0, 0 for x < 0", user=False,

@@ -15,7 +15,7 @@ The language (DESIGN.md section 3):
   constant (`2e` is 2*e, `2e+x` is 2*e + x);
 - variables `x y z`; constants `pi` (also spelled `PI`), `e`; named parameters
   (substituted by their values); function calls `name(arg, ...)` from the function
-  table, with its arity;
+  table, with its arity (`min` and `max` take two or more arguments);
 - `+ - * /`; powers `^` and `**`, right-associative and binding tighter than a unary
   sign (`-x^2` is `-(x^2)`, `2^3^2` is 512, `2^-1` is 1/2); `(...)` and `[...]`;
 - implicit multiplication, binding like `*`: `4x^2(x+1)`, `x^2y^2`, `(x+1)(x-1)`,
@@ -41,6 +41,12 @@ Semantics:
   numerically, except calls with rational arguments: they are NaN in a shader.
 - `min` and `max` are built unevaluated: sympy compares every pair of (flattened)
   arguments symbolically when it evaluates them, which takes minutes for nested calls.
+  With more than two arguments they are a balanced tree of two-argument calls
+  (`_call_expr`).
+
+Errors name every unknown name at once (each use marked, with a `help:` line saying how
+to give values), and common notations from print get their implc spelling as a hint
+(`sin^2(x)`, `|x|`, full-width letters).
 
 Limits (`Limits`, each a command-line option named after its field) are checked on the
 AST before sympy builds anything: input length first, on the raw string; then nesting
@@ -63,11 +69,11 @@ from functools import cache
 import sympy
 
 from implc.errors import InputError, LimitError, Source
-from implc.functions import CONSTANTS, USER_FUNCTIONS
+from implc.functions import CONSTANTS, USER_FUNCTIONS, Function
 from implc.symbols import X, Y, Z
 
-__all__ = ["Limits", "check_param_name", "fold_constants", "param_symbol", "parse_equation",
-           "parse_equation_with_params", "parse_number"]
+__all__ = ["Limits", "check_param_name", "fold_constants", "param_symbol", "parse_constant",
+           "parse_equation", "parse_equation_with_params", "parse_number"]
 
 
 @dataclass(frozen=True)
@@ -166,6 +172,8 @@ _FUNCTION_ALIASES: dict[str, str] = {
     "th": "tanh",
 }
 _POWER_FUNCTIONS = ("pow", "power", "powf")
+_MAX_NAMES_SHOWN = 5  # unknown names listed in one message
+_MAX_MARKS = 50  # their uses marked under the echoed line
 
 # Other spellings of the constants that real dialects use and that mean nothing else:
 # surf and SURFER write `PI` (corpus: IMAGINARY/surfer-alggeo-gtk). Not `E`: it is a
@@ -229,8 +237,37 @@ def param_symbol(name: str) -> sympy.Symbol:
     return sympy.Symbol(name, real=True)
 
 
+def parse_constant(
+    source: Source,
+    limits: Limits = Limits(),  # noqa: B008 - frozen, so a shared default is safe
+) -> sympy.Expr:
+    """A parameter's value (`--param phi=(1+sqrt(5))/2`): a number or a constant
+    expression of the equation language, read by the same parser with the same checks.
+
+    Exact: a rational stays a `Rational` (`0.1` is 1/10), anything else the sympy
+    expression as written (`1/2 + sqrt(5)/2`; the equation folds it like an inline
+    constant). Raises `InputError` located in `source` for x, y, z, `=`, a non-real or
+    non-finite value and everything `parse_equation` refuses.
+    """
+    text = source.text
+    stripped = text.strip(_WHITESPACE)
+    lead = len(text) - len(text.lstrip(_WHITESPACE))
+    if not stripped:
+        raise InputError("empty number", source, 0, max(1, len(text)))
+    if stripped.lstrip("+-").lower() in ("nan", "inf", "infinity"):
+        raise InputError(f"number must be finite, got {_quote(stripped)}", source, lead,
+                         len(stripped))
+    if re.fullmatch(r"[+-]?0[xXoObB]\w*", stripped):  # not 0 times the name x10
+        raise InputError(f"invalid number {_quote(stripped)}", source, lead, len(stripped))
+    value = _parse(source, None, limits, keep_params=False, constant=True)[0]
+    if value.has(sympy.Min, sympy.Max):  # built unevaluated; of numbers, cheap to evaluate
+        value = value.doit()
+    return value
+
+
 def _parse(
-    source: Source, params: Mapping[str, sympy.Expr] | None, limits: Limits, keep_params: bool
+    source: Source, params: Mapping[str, sympy.Expr] | None, limits: Limits, keep_params: bool,
+    constant: bool = False,
 ) -> tuple[sympy.Expr, sympy.Expr | None]:
     text = source.text
     if len(text) > limits.max_chars:
@@ -246,10 +283,12 @@ def _parse(
     values = _param_values(params or {})
     try:
         tokens = _tokenize(text, values)
-        root = _Parser(source, tokens, values, limits).parse()
+        root = _Parser(source, tokens, values, limits, constant).parse()
         info = _Analyzer(source, values, limits).analyze(root)
         builder = _Builder(source, values, info, limits)
-        expr = builder.build(root)
+        expr = builder.build(root, constant)
+        if constant:
+            return expr, None
         folded = fold_constants(expr)
         if not keep_params:
             return folded, None
@@ -415,18 +454,28 @@ def _build_symbolic(
             exponent = built[node.exponent] if power is None else numeric[node.exponent]
             built[node] = _symbolic_power(built[node.base], exponent, power)
         elif isinstance(node, _Call):
-            function = USER_FUNCTIONS[node.name]
-            args = [built[a] for a in node.args]
-            if function.sympy_name in _UNEVALUATED:
-                expr = function.build(*args, evaluate=False)
-            else:
-                expr = function.build(*args)
+            expr = _call_expr(USER_FUNCTIONS[node.name], [built[a] for a in node.args])
             if expr.has(sympy.cot):
                 expr = expr.replace(sympy.cot, lambda u: 1 / sympy.tan(u))
             built[node] = expr
         else:  # pragma: no cover - numbers and variables hold no parameter
             raise AssertionError(f"unexpected node {node!r}")
     return built[root]
+
+
+def _call_expr(function: Function, args: list[sympy.Expr]) -> sympy.Expr:
+    """A table function applied to built arguments. min and max are built unevaluated (see
+    the module docstring), and with more than two arguments as a balanced tree of
+    two-argument calls, the tree the printers fold them into anyway: sympy differentiates
+    an n-ary Max through an evaluated Max of the other arguments, which compares them
+    pairwise (max of 8 trigonometric terms: 23 s for the Hessian, 1.1 s as a tree)."""
+    if function.sympy_name not in _UNEVALUATED:
+        return function.build(*args)
+    if len(args) <= 2:
+        return function.build(*args, evaluate=False)
+    half = (len(args) + 1) // 2
+    return function.build(_call_expr(function, args[:half]), _call_expr(function, args[half:]),
+                          evaluate=False)
 
 
 def _symbolic_power(base: sympy.Expr, exponent: sympy.Expr, power: Fraction | None) -> sympy.Expr:
@@ -612,26 +661,50 @@ def _tokenize(text: str, params: Mapping[str, object]) -> list[_Token]:
             tokens.append(_Token("op", operator, pos, pos + len(operator)))
             pos += len(operator)
             continue
-        tokens.append(_Token("bad", ch, pos, pos + 1, _bad_character_message(ch)))
+        tokens.append(_Token("bad", ch, pos, pos + 1, _bad_character_message(text, pos)))
         break
     tokens.append(_Token("end", "", len(text), len(text)))
     return tokens
 
 
-def _bad_character_message(ch: str) -> str:
+def _bad_character_message(text: str, pos: int) -> str:
+    ch = text[pos]
     code = f"U+{ord(ch):04X}"
     if ch.isascii():
         if not ch.isprintable():
             return f"unexpected control character {code}"
         shown = f'"{ch}"' if ch == "'" else f"'{ch}'"
+        if ch == "|":  # |x|, as printed
+            end = text.find("|", pos + 1)
+            if end < 0 or "\n" in text[pos:end]:
+                return f"unexpected character {shown}; use abs(...) for an absolute value"
+            return f"unexpected character {shown}; did you mean " \
+                   f"{_quote(f'abs({text[pos + 1:end]})', 40)}?"
         return f"unexpected character {shown}"
+    if ch == "\ufeff":  # text saved by Notepad as "UTF-8 with BOM"
+        return f"unexpected character {code} (a byte order mark); delete it"
     if not ch.isprintable() or ch.isspace():
         hint = "; use a plain space" if ch.isspace() else ""
         return f"unexpected character {code}{hint}"
     if unicodedata.category(ch).startswith("M"):  # shown alone it would sit on the quote
         return f"unexpected combining character {code}"
-    hint = f"; did you mean '{_LOOKALIKES[ch]}'?" if ch in _LOOKALIKES else ""
+    meant = _LOOKALIKES.get(ch) or _compatible_ascii(text, pos)
+    hint = f"; did you mean {_quote(meant)}?" if meant else ""
     return f"unexpected character '{ch}' ({code}){hint}"
+
+
+def _compatible_ascii(text: str, pos: int) -> str:
+    """The ASCII that the run of characters at `pos` stands for, by Unicode's
+    compatibility mapping: full-width `ｓｉｎ` (an input method left in full-width mode) is
+    `sin`, the mathematical italic `𝑥` is `x`. '' when the character has none."""
+    end = pos
+    while end < len(text) and end - pos < 24 and not text[end].isascii():
+        meant = unicodedata.normalize("NFKC", text[end])
+        if text[end] in _LOOKALIKES or not (meant.isascii() and meant.isprintable()
+                                            and meant.strip()):
+            break
+        end += 1
+    return unicodedata.normalize("NFKC", text[pos:end])
 
 
 # --------------------------------------------------------------------------- AST
@@ -734,11 +807,13 @@ class _Parser:
         tokens: list[_Token],
         params: Mapping[str, object],
         limits: Limits,
+        constant: bool = False,
     ):
         self.source = source
         self.tokens = tokens
         self.params = params
         self.limits = limits
+        self.constant = constant  # a parameter's value (parse_constant), not an equation
         self.pos = 0
         self.prev: _Token | None = None
         self.depth = 0
@@ -785,6 +860,8 @@ class _Parser:
         if not token.is_op("="):
             self.expect_end(token)
             return lhs
+        if self.constant:
+            raise self.error_at("a value has no '='", token)
         equals = self.advance()
         self.seen_equals = True
         if self.peek().kind == "end":
@@ -948,8 +1025,74 @@ class _Parser:
                 return self.call(token)
             if self.peek().kind == "bad":  # `sin（x）`: the look-alike bracket is the problem
                 raise self.error_at(self.peek().message, self.peek())
-            raise self.error_at(f"function '{word}' needs arguments in parentheses", token)
-        raise self.error_at(_unknown_name_message(word, followed_by_call, self.params), token)
+            raise self.power_of_function(token)
+        if followed_by_call:
+            raise self.error_at(_unknown_name_message(word, True, self.params), token)
+        raise self.unknown_names(token)
+
+    def power_of_function(self, name: _Token) -> InputError:
+        """`sin x` needs brackets; `sin^2(x)` and `tan^-1(x)`, as printed in books, get
+        the spelling implc reads: `sin(x)^2`, `atan(x)`."""
+        message = f"function '{name.text}' needs arguments in parentheses"
+        tokens, at = self.tokens, self.pos
+        if not tokens[at].is_op("^", "**"):
+            return self.error_at(message, name)
+        at += 1
+        sign = "-" if tokens[at].is_op("-") else ""
+        at += bool(sign)
+        power, opening = tokens[at], tokens[at + 1] if tokens[at].kind == "num" else None
+        if power.kind != "num" or opening is None or not opening.is_op("(", "["):
+            return self.error_at(f"{message}; write {name.text}(...)^n for a power of it",
+                                 name)
+        closing = _matching(tokens, at + 1)
+        if closing is None:
+            return self.error_at(message, name)
+        args = self.source.text[opening.start + 1 : closing.start]
+        written = f"{name.text}({args})^{sign}{power.text}"
+        inverse = "a" + name.text
+        if sign and power.text == "1" and inverse in USER_FUNCTIONS:
+            hint = f"did you mean {_quote(f'{inverse}({args})', 40)} (or {_quote(written, 40)})?"
+        else:
+            hint = f"did you mean {_quote(written, 40)}?"
+        return self.error(f"{message}; {hint}", name.start, closing.end)
+
+    def unknown_names(self, first: _Token) -> InputError:
+        """Every unknown name of the equation at once, each use marked, with how to give
+        them values: a paper's torus has R and r, and one error per run is slow going.
+        Names with a likely intended spelling (`Y`, `x2`) get their hint instead."""
+        uses: dict[str, list[_Token]] = {}
+        for index in range(self.pos - 1, len(self.tokens) - 1):
+            token = self.tokens[index]
+            if (token.kind == "name" and not self.tokens[index + 1].is_op("(")
+                    and token.text not in self.params and token.text not in CONSTANTS
+                    and token.text not in _CONSTANT_ALIASES
+                    and token.text not in USER_FUNCTIONS):
+                uses.setdefault(token.text, []).append(token)
+        names = list(uses)[:_MAX_NAMES_SHOWN]
+        hints = {name: _unknown_name_hint(name, False, self.params) for name in names}
+        free = [name for name in names if not hints[name] and len(_quote(name)) == len(name) + 2
+                and name.lower() not in ("nan", "inf", "infinity")]
+        if len(uses) == 1:
+            hint = hints[first.text]
+            message = f"unknown name {_quote(first.text)}" + (f"; {hint}" if hint else "")
+        else:
+            shown = [_quote(name) + (f" ({hints[name]})" if hints[name] else "")
+                     for name in names]
+            if len(uses) > len(names):
+                shown.append(f"{len(uses) - len(names)} more")
+            message = f"unknown names {', '.join(shown[:-1])} and {shown[-1]}"
+        help_text = None
+        if self.constant:
+            help_text = ("a parameter's value is a number or a constant expression, like "
+                         "(1 + sqrt(5))/2")
+        elif free:
+            given = " ".join(f"--param {name}=VALUE" for name in free)
+            help_text = (f"give {'its value' if len(free) == 1 else 'their values'} with "
+                         f"{given} (in a surface file: under [params])")
+        also = tuple((t.start, t.end - t.start) for name in names for t in uses[name]
+                     if t is not first)[:_MAX_MARKS]
+        return InputError(message, self.source, first.start, first.end - first.start,
+                          also=also, help=help_text)
 
     def call(self, name: _Token) -> _Node:
         opening = self.advance()
@@ -966,50 +1109,70 @@ class _Parser:
                 closing = self.closing(opening)
                 break
         self.contexts.pop()
-        arity = USER_FUNCTIONS[name.text].arity
-        if len(args) != arity:
+        function = USER_FUNCTIONS[name.text]
+        arity = function.arity
+        if len(args) != arity and not (function.variadic and len(args) > arity):
             noun = "argument" if arity == 1 else "arguments"
+            more = " or more" if function.variadic else ""
             raise self.error(
-                f"{name.text} takes {arity} {noun}, got {len(args)}", name.start, closing.end
+                f"{name.text} takes {arity}{more} {noun}, got {len(args)}", name.start,
+                closing.end,
             )
         return self.new(_Call(name.start, closing.end, name.text, args))
 
 
 def _unknown_name_message(word: str, followed_by_call: bool, params: Mapping[str, object]) -> str:
     """`unknown name 'foo'` plus a hint when a likely intended spelling is cheap to find."""
-    shown = _quote(word)
+    message = f"unknown {'function' if followed_by_call else 'name'} {_quote(word)}"
+    hint = _unknown_name_hint(word, followed_by_call, params)
+    return f"{message}; {hint}" if hint else message
+
+
+def _unknown_name_hint(word: str, followed_by_call: bool, params: Mapping[str, object]) -> str:
+    """A likely intended spelling of an unknown name (`did you mean ...?`), or ''."""
     if followed_by_call:
-        message = f"unknown function {shown}"
         lower = word.lower()
         if lower in USER_FUNCTIONS:
-            return f"{message}; did you mean '{lower}'?"
+            return f"did you mean '{lower}'?"
         if lower in _FUNCTION_ALIASES and _FUNCTION_ALIASES[lower] in USER_FUNCTIONS:
-            return f"{message}; did you mean '{_FUNCTION_ALIASES[lower]}'?"
+            return f"did you mean '{_FUNCTION_ALIASES[lower]}'?"
         if lower in _POWER_FUNCTIONS:
-            return f"{message}; use '^' for powers"
+            return "use '^' for powers"
         close = difflib.get_close_matches(word, sorted(USER_FUNCTIONS), n=1)
-        return f"{message}; did you mean '{close[0]}'?" if close else message
-    message = f"unknown name {shown}"
+        return f"did you mean '{close[0]}'?" if close else ""
     if len(word) > 32:  # the hints below cost O(len(word)^2)
-        return message
+        return ""
     known = [*_VARIABLES, *params, *CONSTANTS]
     lower = word.lower()
     if lower in known or lower in USER_FUNCTIONS:
-        return f"{message}; did you mean '{lower}'?"
+        return f"did you mean '{lower}'?"
     digits = re.fullmatch(r"([xyz]+)([0-9]+)", word)
     if digits:
-        return f"{message}; did you mean '{digits.group(1)}^{digits.group(2)}'?"
+        return f"did you mean '{digits.group(1)}^{digits.group(2)}'?"
     for cut in range(1, len(word)):
         head, tail = word[:cut], word[cut:]
         if set(tail) <= set(_VARIABLES):
             if head in USER_FUNCTIONS:
-                return f"{message}; did you mean '{head}({tail})'?"
+                return f"did you mean '{head}({tail})'?"
             if head in params or head in CONSTANTS:
-                return f"{message}; did you mean '{head}*{tail}'?"
+                return f"did you mean '{head}*{tail}'?"
         if set(head) <= set(_VARIABLES) and (tail in params or tail in CONSTANTS):
-            return f"{message}; did you mean '{head}*{tail}'?"
+            return f"did you mean '{head}*{tail}'?"
     close = difflib.get_close_matches(word, sorted(params), n=1)
-    return f"{message}; did you mean '{close[0]}'?" if close else message
+    return f"did you mean '{close[0]}'?" if close else ""
+
+
+def _matching(tokens: list[_Token], at: int) -> _Token | None:
+    """The token closing the bracket `tokens[at]` (either kind), or None."""
+    depth = 0
+    for token in tokens[at:]:
+        if token.is_op("(", "["):
+            depth += 1
+        elif token.is_op(")", "]"):
+            depth -= 1
+            if depth == 0:
+                return token
+    return None
 
 
 # --------------------------------------------------------------------------- analysis
@@ -1274,7 +1437,9 @@ class _Analyzer:
     def visit_call(self, node: _Call, args: list[_Info]) -> _Info:
         constant = all(a.constant for a in args)
         copies = _argument_copies(node.name)
-        size = 1 + sum(n * a.size for n, a in zip(copies, args, strict=True))
+        copies += copies[-1:] * (len(args) - len(copies))  # min and max take more
+        calls = max(1, len(args) - 1)  # max(a, b, c) is two calls (`_call_expr`)
+        size = calls + sum(n * a.size for n, a in zip(copies, args, strict=True))
         return _Info(constant, None, 0 if constant else 1, 1, False, size)
 
 
@@ -1323,10 +1488,14 @@ class _Builder:
     def fail(self, message: str, node: _Node) -> InputError:
         return InputError(message, self.source, node.start, node.end - node.start)
 
-    def build(self, root: _Node) -> sympy.Expr:
+    def build(self, root: _Node, constant: bool = False) -> sympy.Expr:
+        """The expression of `root`; with `constant`, of a value (no x, y, z)."""
         built: dict[_Node, sympy.Expr] = {}
         self.built = built  # every node's expression (the symbolic build reuses them)
         order = _postorder(root)
+        variable = next((n for n in order if isinstance(n, _Var)), None)
+        if constant and variable is not None:
+            raise self.fail("a value must not depend on x, y or z", variable)
         for node in order:
             built[node] = self.make(node, built)
             info = self.info[node]
@@ -1342,7 +1511,7 @@ class _Builder:
         if result.has(*(atom for atom, _ in _NON_REAL_MESSAGES)):
             raise self.locate_non_real(order, built)
         self.check_numbers(order, built)
-        if not result.free_symbols & {X, Y, Z}:
+        if not constant and not result.free_symbols & {X, Y, Z}:
             raise self.fail("equation does not depend on x, y or z", root)
         return result
 
@@ -1581,10 +1750,7 @@ class _Builder:
             self.check_exp_argument(node, args[0])
         if node.name in _GROWING and self.info[node.args[0]].constant:
             self.check_magnitude(node, args[0], "constant value")  # exp(k log r) is r^k
-        if function.sympy_name in _UNEVALUATED:
-            expr = function.build(*args, evaluate=False)
-        else:
-            expr = function.build(*args)
+        expr = _call_expr(function, args)
         if expr.has(sympy.cot):  # tan(x + 3pi/4) is -cot(x + pi/4) to sympy; no target has cot
             expr = expr.replace(sympy.cot, lambda u: 1 / sympy.tan(u))
         if all(self.info[a].constant for a in node.args):

@@ -11,19 +11,22 @@ from .methods import Method
 from .raypoly import coefficient_program, ray_quantity_ops
 from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES
 from .surface import Surface
-from .textform import to_text
+from .textform import to_text, value_text
 
 
 def describe(surface: Surface, method: Method) -> str:
     d = Derivatives(surface.expr)
     degree = polynomial_degree(surface.expr)
+    equation, *substituted = surface.equation_lines()
     lines = [
         f"surface:   {surface.name} ({surface.origin})",
-        f"equation:  {surface.equation}",
+        f"equation:  {equation}",
+        *(f"           {line}" for line in substituted),
         f"degree:    {degree if degree is not None else 'not a polynomial'}",
     ]
     if surface.params:
-        lines.append("params:    " + ", ".join(f"{k} = {v}" for k, v in surface.params.items()))
+        lines.append("params:    " + ", ".join(f"{k} = {value_text(v)}"
+                                               for k, v in surface.params.items()))
     lines += [
         "",
         "derived (point form: p = (x, y, z), unit ray direction D = (dx, dy, dz)):",

@@ -32,10 +32,16 @@ import sympy
 
 from .errors import InputError, Source
 from .fileio import read_input
-from .parse import Limits, check_param_name, parse_equation_with_params, parse_number
+from .parse import (
+    Limits,
+    check_param_name,
+    parse_constant,
+    parse_equation_with_params,
+    parse_number,
+)
 from .resources import data_dir
 from .scene import View, view_problems
-from .textform import to_text
+from .textform import to_text, value_text
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -49,7 +55,7 @@ MAX_FILE_BYTES = 1_000_000
 class Surface:
     name: str
     expr: sympy.Expr  # S(x, y, z); the surface is S = 0; parameters already substituted
-    params: dict[str, sympy.Rational] = field(default_factory=dict)
+    params: dict[str, sympy.Expr] = field(default_factory=dict)  # exact values
     view: View = field(default_factory=View)
     origin: str = "<equation>"  # file path, example name or "<equation>"
     # S with the parameters as symbols (parse.param_symbol), for `--params uniform`;
@@ -69,6 +75,16 @@ class Surface:
     def symbolic_equation(self) -> str:
         """The equation with its parameters by name (what `--params uniform` compiles)."""
         return to_text(self.symbolic_expr)
+
+    def equation_lines(self) -> list[str]:
+        """The equation for people (`list`, `show`): with its parameters by name, as the
+        file writes it, then, when the values change it, `with R = 1, r = 7/20: ...` and
+        the equation with the values substituted (what `--params constant` compiles)."""
+        lines = [self.symbolic_equation]
+        if self.symbolic is not None and self.equation != lines[0]:
+            values = ", ".join(f"{k} = {value_text(v)}" for k, v in self.params.items())
+            lines.append(f"with {values}: {self.equation}")
+        return lines
 
     def uniform_params(self) -> list[str]:
         """The parameters that stay free with `--params uniform`, sorted by name: every
@@ -99,7 +115,7 @@ def load_surface(
     if (spec is None) == (equation is None):
         raise InputError("give either a surface (file or example name) or -e EQUATION")
     limits = limits or Limits()
-    overrides = _parse_param_args(params)
+    overrides = _parse_param_args(params, limits)
     if equation is not None:
         source = Source("<equation>", equation)
         values = dict(overrides)
@@ -117,8 +133,11 @@ def load_surface(
     return _load_toml(path, overrides, limits, origin=str(path))
 
 
-def _parse_param_args(params: Sequence[str]) -> dict[str, sympy.Rational]:
-    values: dict[str, sympy.Rational] = {}
+def _parse_param_args(params: Sequence[str], limits: Limits) -> dict[str, sympy.Expr]:
+    """`--param NAME=VALUE`s; a value is a number or a constant expression
+    (`phi=(1+sqrt(5))/2`), and its errors echo the whole argument with the caret under
+    the fault."""
+    values: dict[str, sympy.Expr] = {}
     for arg in params:
         source = Source("--param", arg)
         name, sep, value = arg.partition("=")
@@ -126,9 +145,10 @@ def _parse_param_args(params: Sequence[str]) -> dict[str, sympy.Rational]:
             raise InputError("expected NAME=VALUE", source, 0, len(arg))
         name = name.strip()
         check_param_name(name, Source("--param", arg))
-        text = value.strip()
-        values[name] = parse_number(text, Source("--param", text, 1, len(arg) - len(value) + 1 +
-                                                 (len(value) - len(value.lstrip()))))
+        start = len(arg) - len(value) + 1  # the value's column in the argument
+        positions = tuple((1, start + i) for i in range(len(value) + 1))
+        values[name] = parse_constant(Source("--param", value, 1, start, positions, (arg,)),
+                                      limits)
     return values
 
 
@@ -137,7 +157,7 @@ VIEW_KEYS = ("radius", "center", "eye", "target", "up", "fov")
 
 
 def _load_toml(
-    path: Path, overrides: Mapping[str, sympy.Rational], limits: Limits, origin: str
+    path: Path, overrides: Mapping[str, sympy.Expr], limits: Limits, origin: str
 ) -> Surface:
     name = str(path)
     raw = read_input(path, "a surface file")
@@ -145,8 +165,12 @@ def _load_toml(
         first = raw[:200].split(b"\n")[0].decode("utf-8", "replace")
         raise InputError(f"file is larger than {MAX_FILE_BYTES} bytes",
                          Source(name, first, 1, 1), 0, 1)
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise InputError("not UTF-8 text: the file is UTF-16 (it starts with a byte order "
+                         "mark); save it as UTF-8", Source(name, "", 1, 1))
     try:
-        text = raw.decode("utf-8")
+        # a byte order mark (Notepad's "UTF-8 with BOM") is not part of the text
+        text = raw.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as err:
         before = raw[: err.start]
         line = before.count(b"\n") + 1
@@ -169,7 +193,7 @@ def _load_toml(
     if not isinstance(equation, str):
         raise where.error(("equation",), "equation must be a string, like "
                                          "equation = \"x^2 + y^2 + z^2 = 1\"", value=True)
-    values: dict[str, sympy.Rational] = {}
+    values: dict[str, sympy.Expr] = {}
     table = data.get("params", {})
     if not isinstance(table, dict):
         raise where.error(("params",), "params must be a table ([params], then name = number)",
@@ -191,7 +215,7 @@ def _load_toml(
     return Surface(title, expr, values, _view(where, data.get("view", {})), origin, symbolic)
 
 
-def _parse(source: Source, values: Mapping[str, sympy.Rational], limits: Limits):
+def _parse(source: Source, values: Mapping[str, sympy.Expr], limits: Limits):
     """(expr with the values substituted, expr with parameter symbols or None)."""
     expr, symbolic = parse_equation_with_params(source, values, limits)
     return expr, (symbolic if values else None)

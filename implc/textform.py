@@ -13,7 +13,24 @@ class _EquationPrinter(StrPrinter):
         name = _NAMES.get(type(expr).__name__, type(expr).__name__)
         return f"{name}({', '.join(self._print(a) for a in expr.args)})"
 
-    _print_Abs = _print_Min = _print_Max = _print_Function
+    _print_Abs = _print_Function
+
+    def _print_Min(self, expr):
+        """min(a, b, c) as written: the parser builds it as min(min(a, b), c)
+        (parse._call_expr); min and max are associative, so flattening prints the same
+        function."""
+        args, stack = [], list(reversed(expr.args))
+        while stack:
+            arg = stack.pop()
+            if type(arg) is type(expr):
+                stack.extend(reversed(arg.args))
+            else:
+                args.append(arg)
+        name = _NAMES[type(expr).__name__]
+        args.sort(key=sympy.default_sort_key)  # sympy's order of a flat min (x before y)
+        return f"{name}({', '.join(self._print(a) for a in args)})"
+
+    _print_Max = _print_Min
 
     def _print_Rational(self, expr):
         """Short fractions stay exact (`9/4`); long ones (from decimal parameters such as
@@ -47,4 +64,10 @@ class _EquationPrinter(StrPrinter):
 
 def to_text(expr: sympy.Expr) -> str:
     """`expr` as `... = 0` in implc's input language (deterministic, `^` for powers)."""
-    return _EquationPrinter({"order": "lex"}).doprint(expr) + " = 0"
+    return value_text(expr) + " = 0"
+
+
+def value_text(expr: sympy.Expr) -> str:
+    """`expr` in implc's input language: a parameter's value (`7/20`, `1.618033988749895`
+    for a long decimal, `1/2 + sqrt(5)/2`)."""
+    return _EquationPrinter({"order": "lex"}).doprint(expr)

@@ -392,3 +392,110 @@ def test_exit_codes_are_documented():
     for name in ("EXIT_OK", "EXIT_INPUT", "EXIT_USAGE", "EXIT_INVALID", "EXIT_TOOL",
                  "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_TERMINATED"):
         assert f"| {getattr(errors, name)} |" in table, name
+
+
+# --------------------------------------------------------------------------- issue 23
+
+
+def test_a_surface_file_with_a_bom_and_crlf_loads(tmp_path):
+    """Notepad's UTF-8 (a byte order mark, CRLF line ends) was "invalid TOML: invalid
+    statement" showing `?equation` (issue 23, point 18)."""
+    surface = tmp_path / "s.toml"
+    surface.write_bytes(b'\xef\xbb\xbfname = "s"\r\nequation = "x^2 + y^2 + z^2 - a"\r\n'
+                        b"[params]\r\na = 2\r\n[view]\r\nradius = 2\r\n")
+    proc = implc("show", str(surface))
+    assert proc.returncode == 0, proc.stderr
+    assert "surface:   s (" in proc.stdout
+
+
+def test_errors_in_a_bom_crlf_file_with_tabs_are_located(tmp_path):
+    surface = tmp_path / "s.toml"
+    surface.write_bytes(b'\xef\xbb\xbfname = "s"\r\nequation = "x^2 +\ty^2 + @"\r\n')
+    proc = implc("show", str(surface))
+    assert proc.returncode == 1
+    header, shown, caret = proc.stderr.splitlines()
+    assert header == f"{surface}:2:25: error: unexpected character '@'"
+    assert shown == '  equation = "x^2 +    y^2 + @"'  # the tab as spaces, no '\r' shown
+    assert caret.index("^") == shown.index("@")
+
+
+def test_a_utf16_surface_file_is_named(tmp_path):
+    surface = tmp_path / "s.toml"
+    surface.write_bytes('equation = "x^2 + y^2 + z^2 - 1"\n'.encode("utf-16"))
+    proc = implc("show", str(surface))
+    assert proc.returncode == 1
+    assert proc.stderr.startswith(f"{surface}:1:1: error: not UTF-8 text: the file is UTF-16 "
+                                  "(it starts with a byte order mark); save it as UTF-8")
+
+
+def test_an_nary_max_compiles_validates_and_renders(tmp_path):
+    """A cube as users write it, max of three (issue 23, point 17): it compiles to a
+    shader its compiler accepts, for the default method and for hessian (derivatives by
+    branch), and renders like the CPU reference."""
+    require_tool("glslangValidator")
+    cube = "max(abs(x), abs(y), abs(z)) - 0.8"
+    for method in ("interval", "hessian"):
+        out = tmp_path / f"{method}.frag"
+        proc = implc("compile", "-e", cube, "-m", method, "--validate", "-o", str(out))
+        assert proc.returncode == 0, proc.stderr
+        assert "// Equation: max(abs(x), abs(y), abs(z)) - 4/5 = 0" in out.read_text()
+    from conftest import require_gl
+
+    require_gl()
+    images = {}
+    for backend in ("gl", "reference"):
+        images[backend] = tmp_path / f"{backend}.png"
+        proc = implc("render", "-e", cube, "-b", backend, "--size", "48",
+                     "-o", str(images[backend]))
+        assert proc.returncode == 0, proc.stderr
+    import numpy as np
+    from PIL import Image
+
+    gl, ref = (np.asarray(Image.open(images[b]).convert("L"), dtype=float) for b in images)
+    background = ref[0, 0]
+    assert (ref != background).mean() > 0.2  # the cube fills much of the frame
+    assert ((gl != background) != (ref != background)).mean() < 0.02
+
+
+def test_a_parameter_value_may_be_a_constant_expression(tmp_path):
+    """`--param "phi=(1+sqrt(5))/2"` was "invalid number" with the caret under the value
+    alone (issue 23, point 12): the equation parser reads it; an error echoes the whole
+    argument with the caret under the fault."""
+    proc = implc("show", "-e", "x^2 + y^2 + z^2 - phi", "--param", "phi=(1+sqrt(5))/2")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines()[1:3] == [
+        "equation:  -phi + x^2 + y^2 + z^2 = 0",
+        "           with phi = 1/2 + sqrt(5)/2: x^2 + y^2 + z^2 - 1.618033988749895 = 0",
+    ]
+    proc = implc("show", "-e", "x^2 + y^2 + z^2 - phi", "--param", "phi = (1+sqrt(5)/2")
+    assert proc.returncode == 1
+    assert proc.stderr.splitlines() == [
+        "--param:1:7: error: unclosed '('",
+        "  phi = (1+sqrt(5)/2",
+        "        ^",
+    ]
+
+
+def test_list_and_show_print_the_equation_with_its_parameter_names():
+    """`list` and `show` printed `2.6180339887498953*z^2` for `phi^2` and `351/400` for
+    `R^2 - r^2` (issue 23, point 16): the equation with the names, then the values and
+    the substituted form below it."""
+    proc = implc("list")
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    torus = next(i for i, line in enumerate(lines) if line.startswith("torus "))
+    assert lines[torus].endswith(" -4*R^2*(x^2 + y^2) + (R^2 - r^2 + x^2 + y^2 + z^2)^2 = 0")
+    assert lines[torus + 1].strip() == ("with R = 1, r = 7/20: -4*x^2 - 4*y^2 + "
+                                        "(x^2 + y^2 + z^2 + 351/400)^2 = 0")
+    barth = next(line for line in lines if line.startswith("barth-sextic "))
+    assert "phi^2*x^2" in barth and "2.618" not in barth
+    roman = lines.index(next(line for line in lines if line.startswith("roman ")))
+    assert not lines[roman + 1].startswith(" ")  # no parameters: one line
+    proc = implc("show", "barth-sextic")
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout.splitlines()
+    assert out[1].startswith("equation:  ") and "4*(phi^2*x^2 - y^2)" in out[1]
+    assert "2.618" not in out[1]
+    assert out[2].startswith("           with phi = 1.618033988749895: 4*(")
+    assert "2.6180339887498953*x^2" in out[2]
+    assert "params:    phi = 1.618033988749895" in proc.stdout

@@ -35,6 +35,7 @@ JOBS = 2
 OPENCL_EVERY = 3  # GPL rows validated on opencl: every third one
 
 FREE = ": a free parameter upstream, with no value in the corpus"
+FREES = ": free parameters upstream, with no value in the corpus"
 # Rows implc refuses on purpose (row number in the shared TSV -> its message). Anything
 # else must compile; a row that starts compiling must be removed from here.
 EXPECTED_REJECTIONS = {
@@ -43,19 +44,19 @@ EXPECTED_REJECTIONS = {
     85: "unknown function 'T_4'",
     98: "unknown function 'T_5'",
     100: "unknown function 'S_5'",
-    103: "unknown name 'phi'",
-    104: "unknown name 'x_0'",
+    103: "unknown names 'phi' and 'w'",
+    104: "unknown names 'x_0', 'x_3', 'x_1' and 'x_2'",
     105: "unknown function 'T_6'",
     110: "unknown function 'T_7'",
-    111: "unknown name 'a_5'",
+    111: "unknown names 'a_5', 'a_1', 'a_2', 'a_3' and 'a_4'",
     112: "unknown function 'T_8'",
-    113: "unknown name 'a'",
-    114: "unknown name 'a'",
+    113: "unknown names 'a', 'b', 'c' and 'd'",
+    114: "unknown names 'a', 'b', 'c' and 'd'",
     116: "unknown function 'T_9'",
     118: "unknown name 'phi'",
     119: "unknown function 'T_n'",
-    120: "unknown name 'S'",
-    123: "unknown name 'k'",
+    120: "unknown names 'S' and 'Q'",
+    123: "unknown names 'k', 'l', 'm' and 's'",
     # parisolab/mathmod (GPL): helpers, conditionals, time, limits
     241: "unknown function 'mandelbulb'",
     242: "unknown function 'MandelFractal'",
@@ -72,12 +73,12 @@ EXPECTED_REJECTIONS = {
     322: "unknown function 'if'",
     # porst17/realsurf: sliders without values
     325: "unknown name 't'" + FREE,
-    329: "unknown name 'R'" + FREE,
-    331: "unknown name 'a'" + FREE,
+    329: "unknown names 'R' and 'r'" + FREES,
+    331: "unknown names 'a' and 'b'" + FREES,
     335: "unknown name 't'" + FREE,
     336: "unknown name 't'" + FREE,
     337: "unknown name 'W'" + FREE,
-    345: "unknown name 'R'" + FREE,
+    345: "unknown names 'R' and 'r'" + FREES,
     348: "unknown name 'mu'" + FREE,
     352: "unknown name 'a'" + FREE,
 }

@@ -14,7 +14,7 @@ import pytest
 from cpu_bound import cpu_limit
 
 from implc.errors import InputError, LimitError, Source
-from implc.parse import parse_equation
+from implc.parse import Limits, parse_equation
 
 DATA = Path(__file__).parent / "data" / "malformed.txt"
 _ESCAPE = re.compile(r"\\(n|t|0|\\|u[0-9A-Fa-f]{4}|.)")
@@ -102,3 +102,58 @@ def test_position_on_a_later_line_of_a_toml_string_restarts_at_column_one() -> N
         "  y^2 + sinn(z)\n"
         "        ^~~~"
     )
+
+
+# --------------------------------------------------------------------------- issue 23
+
+
+def _caret_column(rendered: str) -> int:
+    return rendered.split("\n")[2].index("^")
+
+
+@pytest.mark.parametrize("at", [5, 30_000, 59_990])
+def test_a_long_line_is_cut_to_a_window_around_the_caret(at: int) -> None:
+    """A 60,000-character equation echoed whole was a 20,003-character caret line (issue
+    23, point 10): the line is cut to about 100 columns around the caret, `...` where it
+    was cut, and the header keeps the real column."""
+    text = "x+" * 30_000
+    text = text[:at] + "@" + text[at + 1:]
+    with pytest.raises(InputError) as caught:
+        parse_equation(Source("<equation>", text),
+                       limits=Limits(max_chars=100_000, max_nodes=100_000))
+    rendered = caught.value.render()
+    header, shown, caret = rendered.split("\n")
+    assert header == f"<equation>:1:{at + 1}: error: unexpected character '@'"
+    assert len(shown) <= 2 + 100 and len(caret) <= 2 + 100, rendered
+    assert shown[_caret_column(rendered)] == "@", rendered
+    assert shown.startswith("  ...") == (at > 100)
+    assert shown.endswith("...") == (at < 59_900)
+
+
+def test_the_length_limit_shows_where_the_limit_falls() -> None:
+    text = "x+" * 30_000 + "x"
+    with pytest.raises(LimitError) as caught:
+        parse_equation(Source("<equation>", text))
+    rendered = caught.value.render()
+    assert rendered.startswith("<equation>:1:20001: error: too complex: input length 60001 ")
+    assert max(len(line) for line in rendered.split("\n")[1:]) <= 102, rendered
+    shown = rendered.split("\n")[1]
+    column = _caret_column(rendered)
+    assert shown[column - 3:column + 3] == text[20_000 - 3:20_000 + 3]
+
+
+def test_a_span_cut_by_the_window_ends_at_its_edge() -> None:
+    text = "x + " + "y" * 500 + "(x)"  # 'yyy...y(' is an unknown function
+    with pytest.raises(InputError) as caught:
+        parse_equation(Source("<equation>", text))
+    shown, caret = caught.value.render().split("\n")[1:]
+    assert shown.endswith("...") and len(shown) <= 2 + 100
+    assert caret == "  " + " " * 4 + "^" + "~" * (len(shown) - 3 - 2 - 5)  # to the cut
+
+
+def test_wide_characters_take_two_columns() -> None:
+    """A terminal shows a full-width character two columns wide: the caret after one
+    moves right by two."""
+    with pytest.raises(InputError) as caught:
+        parse_equation(Source("<equation>", "x（ + @"))
+    assert caught.value.render().split("\n")[2] == "   ^~"

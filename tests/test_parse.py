@@ -19,6 +19,7 @@ from implc.parse import (
     check_param_name,
     fold_constants,
     param_symbol,
+    parse_constant,
     parse_equation,
     parse_equation_with_params,
     parse_number,
@@ -208,7 +209,10 @@ def test_every_user_function_parses_with_its_arity(name: str) -> None:
     point = {X: 0.3, Y: 0.7, Z: 0.2}
     expected = function.numpy(*(point[s] for s in (X, Y, Z)[: function.arity]))
     assert float(result.subs(point).evalf()) == pytest.approx(float(expected))
-    if function.arity > 1:
+    if function.variadic:
+        with pytest.raises(InputError, match=f"{name} takes 2 or more arguments, got 1"):
+            parse(f"{name}(x)")
+    elif function.arity > 1:
         with pytest.raises(InputError, match=f"{name} takes {function.arity} arguments, got 1"):
             parse(f"{name}(x)")
     else:
@@ -220,6 +224,28 @@ def test_min_and_max_stay_as_written() -> None:
     result = parse("min(x, min(y, z))")
     assert isinstance(result, sympy.Min)
     assert result.args == (X, sympy.Min(Y, Z, evaluate=False))
+
+
+@pytest.mark.parametrize("count", [3, 4, 7])
+def test_min_and_max_take_more_arguments(count: int) -> None:
+    """`max(abs(x), abs(y), abs(z))` was "max takes 2 arguments, got 3" (issue 23, point
+    17): users write CSG so. Built as a balanced tree of two-argument calls (what printers
+    fold them into; sympy differentiates a flat Max of n through Max of the n - 1 others,
+    comparing them pairwise), printed flat again."""
+    from implc.numeric import evaluate
+    from implc.textform import to_text
+
+    terms = [f"{k}x - y^2 + sin({k}z)" for k in range(1, count + 1)]
+    for name, pick in (("max", max), ("min", min)):
+        result = parse(f"{name}({', '.join(terms)})")
+        calls = result.atoms(sympy.Max if name == "max" else sympy.Min)
+        assert len(calls) == count - 1 and all(len(c.args) == 2 for c in calls)
+        point = {X: 0.3, Y: -0.4, Z: 0.8}
+        values = [float(evaluate(parse(t), point)) for t in terms]
+        assert float(evaluate(result, point)) == pytest.approx(pick(values))
+        printed = to_text(result)
+        assert printed.startswith(f"{name}(") and printed.count(f"{name}(") == 1, printed
+        assert same(printed, result)
 
 
 def test_nested_min_is_built_unevaluated() -> None:
@@ -534,6 +560,57 @@ def test_parse_number_points_into_its_source() -> None:
     with pytest.raises(InputError) as caught:
         parse_number(" 0.5.1", Source("--param", " 0.5.1", col=9))
     assert caught.value.render().startswith("--param:1:10: error: invalid number '0.5.1'")
+
+
+# --------------------------------------------------------------------------- parse_constant
+
+
+@pytest.mark.parametrize(
+    ("text", "value"),
+    [
+        ("(1+sqrt(5))/2", (1 + sympy.sqrt(5)) / 2),
+        ("2pi/3", 2 * sympy.pi / 3),
+        ("0.1", sympy.Rational(1, 10)),
+        (" -2 ", sympy.Integer(-2)),
+        ("1 / -4", sympy.Rational(-1, 4)),
+        ("2^-3", sympy.Rational(1, 8)),
+        ("e^2", sympy.E**2),
+        ("max(1, 2, 3/2)", sympy.Integer(2)),
+        (repr(0.5067166090011597), sympy.Rational(5067166090011597, 10**16)),
+    ],
+)
+def test_parse_constant(text: str, value: sympy.Expr) -> None:
+    """A parameter's value may be a constant expression, read by the equation parser
+    (`--param "phi=(1+sqrt(5))/2"` was "invalid number"; issue 23, point 12); exact."""
+    result = parse_constant(Source("--param", text))
+    assert sympy.simplify(result - value) == 0
+    assert result.is_Rational == value.is_Rational
+
+
+@pytest.mark.parametrize(
+    ("text", "message", "column"),
+    [
+        ("x/2", "a value must not depend on x, y or z", 1),
+        ("1 = 2", "a value has no '='", 3),
+        ("sqrt(-1)", "value is not a real number", 1),
+        ("log(0)", "value is infinite", 1),
+        ("1/(2 - 2)", "division by zero", 3),
+        ("(1+sqrt(5)/2", "unclosed '('", 1),
+        ("nan", "number must be finite, got 'nan'", 1),
+        ("-inf", "number must be finite, got '-inf'", 1),
+        ("0x10", "invalid number '0x10'", 1),
+        ("", "empty number", 1),
+        ("abc", "unknown name 'abc'", 1),
+        ("9^9^9", "too complex: constant power exceeds the limit of 300 digits", 1),
+        ("1e400", "too complex: number '1e400' exceeds the limit of 1e30", 1),
+        ("__import__('os')", "unknown function '__import__'", 1),
+    ],
+)
+def test_parse_constant_rejects(text: str, message: str, column: int) -> None:
+    with pytest.raises(InputError) as caught:
+        parse_constant(Source("--param", text))
+    assert caught.value.message.startswith(message)
+    assert caught.value.render().startswith(f"--param:1:{column}: error: ")
 
 
 # --------------------------------------------------------------------------- check_param_name
