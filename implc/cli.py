@@ -40,10 +40,16 @@ from .fileio import (
     read_input,
     write_atomic,
 )
-from .marcher import AUTO_MAX_DEGREE, EVAL_CHOICES
-from .methods import METHODS, TAYLOR2_CHOICES, Constants
+from .limits import Limits
+from .options import (
+    AUTO_MAX_DEGREE,
+    EVAL_CHOICES,
+    EXACT_MAX_DEGREE,
+    METHOD_NAMES,
+    TAYLOR2_CHOICES,
+    Constants,
+)
 from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
-from .solver import EXACT_MAX_DEGREE
 from .targets import TARGETS
 
 EPILOG = """\
@@ -225,7 +231,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("show", help="print the equation, degree, derivatives and op counts")
     _surface_args(p)
-    p.add_argument("-m", "--method", choices=sorted(METHODS), default=None,
+    p.add_argument("-m", "--method", choices=sorted(METHOD_NAMES), default=None,
                    help="method whose shader functions to count (default: exact for "
                         "polynomials, else interval where every function has an interval "
                         "rule, else hessian)")
@@ -293,7 +299,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="TOML files or bundled example names (e.g. cross-cap miter steiner)")
     p.add_argument("--size", type=int, default=1024,
                    help="square image size in pixels (default 1024, the paper's)")
-    p.add_argument("--methods", nargs="+", choices=list(METHODS), metavar="METHOD",
+    p.add_argument("--methods", nargs="+", choices=list(METHOD_NAMES), metavar="METHOD",
                    help="methods to time (default: taylor curvature hessian-approx hessian sign)")
     p.add_argument("--frames", type=int, default=3,
                    help="timed frames per cell after 1 warm-up; fps is their median (default 3)")
@@ -367,7 +373,7 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
 
 
 def _method_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("-m", "--method", choices=list(METHODS), default=None,
+    p.add_argument("-m", "--method", choices=list(METHOD_NAMES), default=None,
                    help="root-finding method (default: exact for polynomial surfaces up to "
                         f"degree {EXACT_MAX_DEGREE}, else interval where every function has "
                         "an interval rule (not atan2), else hessian); see README \"The "
@@ -404,9 +410,7 @@ LIMIT_FLAGS = {
 }
 
 
-def _default_limits():
-    from .parse import Limits
-
+def _default_limits() -> Limits:
     return Limits()
 
 
@@ -421,9 +425,7 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def _limits(args):
-    from .parse import Limits
-
+def _limits(args) -> Limits:
     given = {flag[2:].replace("-", "_"): getattr(args, flag[2:].replace("-", "_"))
              for flag in LIMIT_FLAGS}
     return Limits(**{k: v for k, v in given.items() if v is not None})
@@ -436,6 +438,8 @@ def _surface(args):
 
 
 def _constants(args) -> Constants:
+    from .methods import METHODS
+
     method = METHODS[args.method]
     values = {
         "step": args.step, "tau1": args.tau1, "tau2": args.tau2, "tau3": args.tau3,
@@ -472,6 +476,7 @@ def _resolve_method(args, surface) -> None:
 
 
 def cmd_show(args) -> int:
+    from .methods import METHODS
     from .show import describe
 
     surface = _surface(args)

@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from ..errors import InputError
-from ..methods import Constants
-from ..surface import Surface
 from ..targets import TARGETS, Backend, resolve
-from .result import RenderResult
+
+if TYPE_CHECKING:  # the command line reads BACKENDS without sympy or numpy
+    from ..methods import Constants
+    from ..surface import Surface
+    from .result import RenderResult
 
 
 class Runner(Protocol):
