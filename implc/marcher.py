@@ -101,6 +101,16 @@ def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
     return "ray-poly" if degree is not None and degree <= AUTO_MAX_DEGREE else "point"
 
 
+def used_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> str:
+    """The evaluation form `method`'s shader for `expr` uses when `requested` is asked (as
+    `lower` prints it; what a render's sidecar records): the exact solver works on the ray
+    polynomial, the interval method at points, a marcher takes `choose_form`'s."""
+    form = choose_form(expr, requested)
+    if method.solves:
+        return "ray-poly"
+    return "point" if method.bounds else form
+
+
 def default_method(expr: sympy.Expr) -> str:
     """The method `-m` defaults to: `exact` for polynomials up to EXACT_MAX_DEGREE (no false
     and no missed roots, the fastest there), `interval` for any other surface whose

@@ -160,6 +160,25 @@ class Method:
         """Whether --taylor2 selects among readings of this method's root test."""
         return not isinstance(self.root, Rule)
 
+    @property
+    def reads(self) -> frozenset[str]:
+        """The command line's method constants (fields of Constants) that this method's
+        shader depends on, from its data: the constant symbols of its sample, step and
+        root expressions (every --taylor2 reading), `taylor2` where the root test has
+        readings, and `max_steps` and `evaluation` for a marcher (the exact solver and
+        the interval bisection print no step cap and choose no evaluation form: see
+        marcher.lower). The command line warns about a constant given outside this."""
+        rules = (self.root,) if isinstance(self.root, Rule) else tuple(self.root.values())
+        exprs = (*self.sample, self.step, *(r.value for r in rules),
+                 *(v for r in rules for _, v in r.lets))
+        used = set().union(*(sympy.sympify(e).free_symbols for e in exprs))
+        fields = {c.name.lower() for c in CONSTANT_SYMBOLS if c in used}
+        if self.reads_taylor2:
+            fields.add("taylor2")
+        if not (self.solves or self.bounds):
+            fields |= {"max_steps", "evaluation"}
+        return frozenset(fields)
+
     def root_rule(self, taylor2: str) -> Rule:
         return self.root if isinstance(self.root, Rule) else self.root[taylor2]
 

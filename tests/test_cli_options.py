@@ -7,6 +7,7 @@ usage); bad input (the equation, a file, a parameter, an output path) exits 1.
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -100,3 +101,39 @@ def test_an_unknown_example_name_gets_a_hint(name, hint):
     assert proc.returncode == 1
     assert proc.stderr.strip() == (
         f"implc: error: no file or bundled example named '{name}'; {hint} (see `implc list`)")
+
+
+# --- point 6 (data) and 19 (sidecar): what a method reads, what a render used -----------
+
+CHANGED = {"step": 0.0125, "tau1": 0.02, "tau2": 0.03, "tau3": 0.04, "eps": 2e-3,
+           "taylor2": "consistent", "max_steps": 123, "evaluation": "point"}
+
+
+@pytest.mark.parametrize("method", ["sign", "taylor", "curvature", "hessian",
+                                    "hessian-approx", "exact", "interval"])
+def test_what_a_method_reads_is_what_changes_its_shader(method):
+    """Method.reads (the warning's data) is exactly the set of constants whose value
+    changes the method's shader (a quartic: ray-poly is auto's form)."""
+    from implc.emit import emit
+    from implc.methods import METHODS
+    from implc.surface import load_surface
+
+    surface = load_surface(equation="x^4 + y^4 + z^4 - 1")
+    meth = METHODS[method]
+    base = emit(surface, "glsl", method, meth.constants())
+    changes = {field for field, value in CHANGED.items()
+               if emit(surface, "glsl", method, meth.constants(**{field: value})) != base}
+    assert changes == meth.reads
+
+
+def test_the_sidecar_records_the_form_used(tmp_path):
+    from conftest import require_gl
+
+    require_gl()
+    for method, form in (("taylor", "ray-poly"), ("exact", "ray-poly"),
+                         ("interval", "point")):
+        out = tmp_path / f"{method}.png"
+        proc = implc("render", "sphere", "-m", method, "--size", "8", "-o", str(out))
+        assert proc.returncode == 0, proc.stderr
+        sidecar = json.loads(out.with_suffix(".json").read_text())
+        assert sidecar["method"]["evaluation"] == form, method

@@ -121,9 +121,16 @@ def metadata(
     surface: Surface, backend: str, method: str, constants: Constants, result: RenderResult,
     params: str = "constant",
 ) -> dict:
-    """The JSON sidecar: enough to recompute every pixel's ray and to reproduce the run."""
-    method_json = {"name": REFERENCE} if backend == REFERENCE else {
-        "name": method, **constants.as_dict()}
+    """The JSON sidecar: enough to recompute every pixel's ray and to reproduce the run
+    (`evaluation` is the form the shader used, not `auto`)."""
+    if backend == REFERENCE:
+        method_json = {"name": REFERENCE}
+    else:
+        from ..marcher import used_form
+        from ..methods import get_method
+
+        form = used_form(get_method(method), surface.expr, constants.evaluation)
+        method_json = {"name": method, **constants.as_dict(), "evaluation": form}
     return {
         "surface": {
             "name": surface.name,
