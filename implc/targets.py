@@ -18,6 +18,7 @@ so that the registry is plain data the command line reads without importing symp
 from __future__ import annotations
 
 import importlib
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -67,6 +68,8 @@ class Target:
     # (uniforms, a uniform struct) or "argument" (a Params struct that every function
     # evaluating S takes: OpenCL C has no program-scope variables set at run time)
     params_read_as: str = "global"
+    # name prefixes the language reserves (`--prefix gl_` would write an invalid shader)
+    reserved_prefixes: tuple[str, ...] = ()
 
     @property
     def printer(self) -> Callable[..., object]:
@@ -84,7 +87,8 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         backends={"gl": Backend("implc.render.gl:open_gl_runner",
                                 "GLSL 330 on OpenGL (moderngl, EGL; llvmpipe here)")},
         flavors=GLSL_FLAVORS,
-        default_flavor="330",
+        default_flavor="330",  # also the program the gl backend runs (render/gl.py)
+        reserved_prefixes=("gl_",),
     ),
     Target(
         name="wgsl",
@@ -130,3 +134,37 @@ def get_target(name: str) -> Target:
 def target_of_file(suffix: str) -> Target | None:
     """The target whose language a shader file with this extension is written in."""
     return next((t for t in TARGETS.values() if suffix in t.extensions), None)
+
+
+def flavor_problem(target: Target, flavor: str) -> str | None:
+    """Why `flavor` is not one of `target`'s flavours, naming the choices (None: it is)."""
+    if flavor in target.flavors:
+        return None
+    if len(target.flavors) == 1:
+        having = " and ".join(t.name for t in TARGETS.values() if len(t.flavors) > 1)
+        return f"{target.name} has no flavours (--flavor applies to {having} only)"
+    return f"unknown {target.name} flavour '{flavor}'; choose from {', '.join(target.flavors)}"
+
+
+_PREFIX_RE = re.compile(r"[A-Za-z0-9_]*\Z")
+
+
+def prefix_problem(prefix: str, target: Target) -> str | None:
+    """Why `prefix` cannot start every global name of a `target` shader (None: it can).
+
+    It is glued to names (`cc_` + `S`, upper-cased before constants: `CC_STEP`), so it
+    must be an identifier's start; `__` is reserved in GLSL (anywhere in a name), WGSL
+    and OpenCL C (at the start), and a target may reserve prefixes of its own (GLSL:
+    `gl_`)."""
+    if not _PREFIX_RE.match(prefix):
+        return f"--prefix must be letters, digits and '_' (got '{prefix}')"
+    if prefix[:1].isdigit():
+        return (f"--prefix must not start with a digit: names start with it, and a name "
+                f"cannot (got '{prefix}')")
+    if "__" in prefix:
+        return f"--prefix must not contain '__': GLSL reserves such names (got '{prefix}')"
+    for reserved in target.reserved_prefixes:
+        if prefix.startswith(reserved):
+            return (f"--prefix must not start with '{reserved}': {target.name} reserves names "
+                    f"that start with it (got '{prefix}')")
+    return None

@@ -38,6 +38,107 @@ def usage_error(proc, command: str) -> str:
     return lines[0][len(f"{prog}: error: "):]
 
 
+LIMITS = ["--max-chars", "--max-depth", "--max-nodes", "--max-exponent", "--max-degree",
+          "--max-terms", "--max-literal-exponent", "--max-constant-digits", "--max-derived"]
+CONSTANTS = ["--step", "--tau1", "--tau2", "--tau3", "--eps"]
+
+# (argv, what the message must say); OUT is a scratch directory
+BAD_OPTIONS = [
+    (["compile", "sphere", "-m", "nope"], "invalid choice: 'nope'"),
+    (["compile", "sphere", "-t", "bogus"], "invalid choice: 'bogus'"),
+    (["compile", "sphere", "--flavor", "300es"],
+     "--flavor: unknown glsl flavour '300es'; choose from 330, 450, es300, shadertoy"),
+    (["compile", "sphere", "-t", "wgsl", "--flavor", "es300"],
+     "--flavor: wgsl has no flavours (--flavor applies to glsl only)"),
+    (["compile", "sphere", "--precision", "double"],
+     "--precision double: glsl has float only (double: opencl)"),
+    (["compile", "sphere", "--precision", "half"], "invalid choice: 'half'"),
+    (["compile", "sphere", "--params", "bogus"], "invalid choice: 'bogus'"),
+    (["compile", "sphere", "--emit", "bogus"], "invalid choice: 'bogus'"),
+    (["compile", "sphere", "--emit", "library", "--prefix", "c-c"],
+     "--prefix must be letters, digits and '_' (got 'c-c')"),
+    (["compile", "sphere", "--emit", "library", "--prefix", "1cc_"],
+     "--prefix must not start with a digit: names start with it, and a name cannot "
+     "(got '1cc_')"),
+    (["compile", "sphere", "--emit", "library", "--prefix", "gl_"],
+     "--prefix must not start with 'gl_': glsl reserves names that start with it "
+     "(got 'gl_')"),
+    (["compile", "sphere", "-t", "wgsl", "--emit", "library", "--prefix", "cc__"],
+     "--prefix must not contain '__': GLSL reserves such names (got 'cc__')"),
+    (["compile", "sphere", "--taylor2", "bogus"], "invalid choice: 'bogus'"),
+    (["compile", "sphere", "--eval", "bogus"], "invalid choice: 'bogus'"),
+    (["compile", "sphere", "--max-steps", "0"],
+     "argument --max-steps: expected an integer from 1 to 10000000, got 0"),
+    (["compile", "sphere", "--max-steps", "1.5"],
+     "argument --max-steps: expected an integer, got '1.5'"),
+    *[(["compile", "sphere", flag, "0"], f"argument {flag}: expected a positive number")
+      for flag in CONSTANTS],
+    (["compile", "sphere", "--step", "-1"], "argument --step: expected a positive number"),
+    (["compile", "sphere", "--step", "nan"], "argument --step: expected a positive number"),
+    (["compile", "sphere", "--step", "abc"], "argument --step: expected a positive number"),
+    *[(["compile", "sphere", flag, "0"], f"argument {flag}: expected an integer from 1")
+      for flag in LIMITS],
+    (["compile", "sphere", "-e", "x^2 - 1"],
+     "give a surface (a file or a bundled example name) or -e EQUATION, not both"),
+    (["compile"], "give a surface (a file or a bundled example name) or -e EQUATION"),
+    (["show"], "give a surface (a file or a bundled example name) or -e EQUATION"),
+    (["show", "sphere", "-m", "nope"], "invalid choice: 'nope'"),
+    (["render", "sphere", "-b", "bogus", "-o", "OUT/a.png"], "invalid choice: 'bogus'"),
+    (["render", "sphere", "--size", "0", "-o", "OUT/a.png"],
+     "argument --size: expected an integer from 1 to 8192, got 0"),
+    (["render", "sphere", "--size", "9000", "-o", "OUT/a.png"],
+     "argument --size: expected an integer from 1 to 8192, got 9000"),
+    (["render", "sphere", "--width", "0", "-o", "OUT/a.png"],
+     "argument --width: expected an integer from 1 to 8192, got 0"),
+    (["render", "sphere", "--height", "-3", "-o", "OUT/a.png"],
+     "argument --height: expected an integer from 1 to 8192, got -3"),
+    (["render", "sphere", "--size", "16", "--width", "16", "-o", "OUT/a.png"],
+     "give --size or --width/--height, not both"),
+    (["render", "sphere", "-t", "wgsl", "-b", "gl", "-o", "OUT/a.png"],
+     "-t wgsl renders with -b wgpu, not -b gl"),
+    (["render", "sphere", "-t", "glsl", "-b", "reference", "-o", "OUT/a.png"],
+     "-t glsl renders with -b gl, not -b reference"),
+    (["render", "sphere", "--flavor", "shadertoy", "-o", "OUT/a.png"],
+     "--flavor shadertoy: -b gl renders the 330 program; the other flavours are for "
+     "`implc compile`"),
+    (["render", "sphere", "-b", "wgpu", "--flavor", "es300", "-o", "OUT/a.png"],
+     "--flavor: wgsl has no flavours (--flavor applies to glsl only)"),
+    (["render", "sphere", "--precision", "double", "-o", "OUT/a.png"],
+     "--precision double renders with -b cl or cl-double only"),
+    (["render", "sphere", "--step", "0", "-o", "OUT/a.png"], "argument --step"),
+    (["view", "sphere", "--step", "0", "-o", "OUT/a.html"], "argument --step"),
+    (["view", "sphere", "-m", "nope", "-o", "OUT/a.html"], "invalid choice: 'nope'"),
+    (["compare", "OUT/a.exr", "OUT/b.exr", "--t-tol", "0"], "argument --t-tol"),
+    (["bench", "sphere", "--size", "4", "-o", "OUT/b"],
+     "argument --size: expected an integer from 8 to 8192, got 4"),
+    (["bench", "sphere", "--frames", "0", "-o", "OUT/b"],
+     "argument --frames: expected an integer from 1 to 1000, got 0"),
+    (["bench", "sphere", "--equal-step", "0", "-o", "OUT/b"], "argument --equal-step"),
+    (["bench", "sphere", "--configs", "paper,bogus", "-o", "OUT/b"],
+     "--configs: unknown configuration 'bogus'; choose from paper, equal, taylor2, extremum"),
+    (["bench", "sphere", "--methods", "taylor", "taylor", "-o", "OUT/b"],
+     "--methods: taylor is listed twice"),
+    (["bench", "sphere", "-b", "reference", "-o", "OUT/b"], "invalid choice: 'reference'"),
+    (["corpus", "-j", "-1"], "argument -j/--jobs: expected an integer from 0 to 64, got -1"),
+    (["corpus", "--rows", "abc"], "--rows: expected numbers like 1-20,35, got 'abc'"),
+    (["corpus", "-t", "bogus"], "invalid choice: 'bogus'"),
+    (["validate"], "the following arguments are required: FILE"),
+    (["frobnicate"], "invalid choice: 'frobnicate'"),
+    (["--bogus"], "unrecognized arguments: --bogus"),
+]
+
+
+@pytest.mark.parametrize(("argv", "expected"), BAD_OPTIONS,
+                         ids=[" ".join(a) for a, _ in BAD_OPTIONS])
+def test_a_bad_command_line_exits_2_with_one_line(tmp_path, argv, expected):
+    argv = [a.replace("OUT", str(tmp_path)) for a in argv]
+    command = argv[0] if argv[0] in ("compile", "show", "render", "view", "compare",
+                                     "bench", "corpus", "validate") else ""
+    message = usage_error(implc(*argv), command)
+    assert expected in message, message
+    assert list(tmp_path.iterdir()) == []  # nothing written, no bench directory
+
+
 # --- point 4: a parameter the equation does not use is an error, not ignored ----------
 
 def test_a_param_the_equation_does_not_use_is_an_error():
@@ -103,7 +204,70 @@ def test_an_unknown_example_name_gets_a_hint(name, hint):
         f"implc: error: no file or bundled example named '{name}'; {hint} (see `implc list`)")
 
 
-# --- point 6 (data) and 19 (sidecar): what a method reads, what a render used -----------
+# --- points 5 and 7: -t and -o choose the language, never ignored ------------------------
+
+def test_compile_takes_the_target_from_the_output_extension(tmp_path):
+    for name, first in (("s.wgsl", "// Generated by implc"), ("s.cl", "// Generated by implc")):
+        out = tmp_path / name
+        proc = implc("compile", "sphere", "-m", "taylor", "-o", str(out))
+        assert proc.returncode == 0, proc.stderr
+        target = "wgsl" if name.endswith("wgsl") else "opencl"
+        expected = implc("compile", "sphere", "-m", "taylor", "-t", target).stdout
+        assert out.read_text() == expected and expected.startswith(first)
+    proc = implc("compile", "sphere", "-m", "taylor", "-o", "-")  # standard output
+    assert proc.returncode == 0 and proc.stdout.startswith("#version 330 core")
+    assert not (ROOT / "-").exists()
+    # -t given: the extension must be its language's
+    proc = implc("compile", "sphere", "-t", "glsl", "-o", str(tmp_path / "x.wgsl"))
+    assert proc.returncode == 1
+    assert "a glsl shader needs .frag or .glsl, not '.wgsl'" in proc.stderr
+
+
+def test_prefixes_other_targets_allow_are_accepted():
+    proc = implc("compile", "sphere", "-m", "taylor", "-t", "wgsl", "--emit", "library",
+                 "--prefix", "gl_")
+    assert proc.returncode == 0, proc.stderr
+    assert "fn gl_S(" in proc.stdout
+
+
+@pytest.mark.parametrize(("target", "backend"), [("wgsl", "wgpu"), ("opencl", "cl")])
+def test_render_with_a_target_uses_its_backend(tmp_path, target, backend):
+    from conftest import require_backend
+
+    require_backend(backend)
+    out = tmp_path / "a.png"
+    proc = implc("render", "sphere", "-t", target, "--size", "16", "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert f"with {backend}/exact" in proc.stderr
+    assert json.loads(out.with_suffix(".json").read_text())["backend"] == backend
+
+
+# --- point 6: a constant the method does not read is said, not dropped -------------------
+
+def test_a_constant_the_method_does_not_read_is_a_warning():
+    proc = implc("compile", "torus", "--step", "0.5", "--tau1", "7")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.strip() == (
+        "implc compile: warning: --step and --tau1 do not apply to method exact (the "
+        "default for this surface), which reads none of the method constants: ignored")
+    assert proc.stdout == implc("compile", "torus").stdout
+    proc = implc("compile", "torus", "-m", "taylor", "--taylor2", "consistent", "--eps", "0.1")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.strip() == (
+        "implc compile: warning: --eps and --taylor2 do not apply to method taylor, which "
+        "reads --step, --tau1, --tau2, --tau3, --max-steps, --eval: ignored")
+    proc = implc("compile", "torus", "-m", "hessian", "--taylor2", "consistent")
+    assert proc.returncode == 0 and proc.stderr == ""
+
+
+def test_method_options_with_the_reference_are_a_warning(tmp_path):
+    proc = implc("render", "sphere", "-b", "reference", "-m", "hessian", "--step", "0.1",
+                 "--size", "8", "-o", str(tmp_path / "a.png"))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.splitlines()[0] == (
+        "implc render: warning: -m and --step do not apply to -b reference (the exact CPU "
+        "reference runs no method and no shader): ignored")
+
 
 CHANGED = {"step": 0.0125, "tau1": 0.02, "tau2": 0.03, "tau3": 0.04, "eps": 2e-3,
            "taylor2": "consistent", "max_steps": 123, "evaluation": "point"}
@@ -124,6 +288,24 @@ def test_what_a_method_reads_is_what_changes_its_shader(method):
     changes = {field for field, value in CHANGED.items()
                if emit(surface, "glsl", method, meth.constants(**{field: value})) != base}
     assert changes == meth.reads
+
+
+# --- point 19: help and the sidecar say what is true --------------------------------------
+
+def test_help_states_defaults_and_the_truth():
+    text = " ".join(implc("compile", "--help").stdout.split())
+    assert "program (default): a complete shader" in text
+    assert "(default: none)" in text  # --prefix
+    assert "Estrin" in text and "Horner" not in text  # --eval
+    assert "extremum" in text  # --taylor2
+    assert "- or none: standard output" in text
+    text = " ".join(implc("render", "--help").stdout.split())
+    assert "--width W image width in pixels; alone, the image is square (W x W)" in text
+    assert "--height H image height in pixels; alone, the image is square (H x H)" in text
+    for command in ("list", "validate"):
+        proc = implc(command, "--help")
+        body = proc.stdout.split("\n\n")[1]  # the description, after the usage
+        assert not body.startswith(("positional", "options")), proc.stdout
 
 
 def test_the_sidecar_records_the_form_used(tmp_path):
