@@ -17,7 +17,7 @@ NPM_STAMP := $(NPM_DIR)/node_modules/.implc-installed
 VIEW_SURFACE := torus
 
 .PHONY: setup demo view test golden lint bench bench-baseline forms clean system-packages fuzz corpus \
-  compile-times
+  compile-times startup
 
 setup: system-packages $(STAMP) $(NPM_STAMP)
 
@@ -122,6 +122,12 @@ corpus-interval: setup
 # ten (docs/RESULTS.md section 6). About 2 minutes on 2 cores.
 compile-times: setup
 	$(PY) scripts/compile_times.py -j 2
+
+# Start-up time of `implc --help`, `COMMAND --help`, `--version` (goal: under 0.15 s; no
+# sympy or numpy is imported for them) and of `list` and `show` for comparison: medians
+# of 7 fresh processes each, as a table. About 30 s.
+startup: setup
+	$(PY) scripts/startup.py
 
 clean:
 	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules

@@ -42,11 +42,17 @@ from .fileio import (
     read_input,
     write_atomic,
 )
-from .marcher import AUTO_MAX_DEGREE, EVAL_CHOICES
-from .methods import METHODS, TAYLOR2_CHOICES, Constants
+from .limits import Limits
+from .options import (
+    AUTO_MAX_DEGREE,
+    EVAL_CHOICES,
+    EXACT_MAX_DEGREE,
+    METHOD_NAMES,
+    TAYLOR2_CHOICES,
+    Constants,
+)
 from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
-from .solver import EXACT_MAX_DEGREE
-from .targets import TARGETS
+from .targets import TARGETS, Target, flavor_problem, prefix_problem, target_of_file
 
 EPILOG = """\
 surfaces: a TOML file, a bundled example name (see `implc list`), or -e "EQUATION".
@@ -103,6 +109,30 @@ class _GuardedStdout:
         return getattr(self._stream, name)
 
 
+class UsageError(ImplcError):
+    """A bad command line: an unknown option or choice, a value out of range, options
+    that contradict each other. Exit 2, one line naming the command and where its
+    options are listed (not argparse's whole usage message)."""
+
+    exit_code = EXIT_USAGE
+
+    def __init__(self, message: str, command: str | None = None):
+        super().__init__(message)
+        self.message = message
+        self.command = command  # "implc compile"; None: main fills it in
+
+    def render(self) -> str:
+        prog = self.command or "implc"
+        return f"{prog}: error: {self.message}\nsee '{prog} --help' for the options"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, with its errors raised as UsageError (main prints them in one line)."""
+
+    def error(self, message: str):
+        raise UsageError(message, self.prog)
+
+
 class Terminated(BaseException):
     """SIGTERM, raised like KeyboardInterrupt so temporary files are cleaned up."""
 
@@ -144,6 +174,8 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.flush()  # a full disk under `> file` is reported here, not at exit
         return code
     except ImplcError as err:
+        if isinstance(err, UsageError) and err.command is None:
+            err.command = "implc" if command == "implc" else f"implc {command}"
         if isinstance(err, StdoutError):
             _detach_stdout()  # what is still buffered would fail again at exit
         print(err.render(), file=sys.stderr)
@@ -219,7 +251,7 @@ def _join_equation_values(argv: list[str]) -> list[str]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="implc",
         description="Compile implicit-surface equations into robust GPU ray-marching shaders.",
         epilog=EPILOG,
@@ -228,12 +260,15 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"implc {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
-    p = sub.add_parser("list", help="list the bundled example surfaces")
+    p = sub.add_parser("list", help="list the bundled example surfaces",
+                       description="The bundled example surfaces (examples/): name, degree "
+                                   "(or non-poly) and equation. Give a name wherever a "
+                                   "SURFACE is asked, e.g. `implc render torus -o t.png`.")
     p.set_defaults(run=cmd_list)
 
     p = sub.add_parser("show", help="print the equation, degree, derivatives and op counts")
     _surface_args(p)
-    p.add_argument("-m", "--method", choices=sorted(METHODS), default=None,
+    p.add_argument("-m", "--method", choices=sorted(METHOD_NAMES), default=None,
                    help="method whose shader functions to count (default: exact for "
                         "polynomials, else interval where every function has an interval "
                         "rule, else hessian)")
@@ -246,15 +281,23 @@ def build_parser() -> argparse.ArgumentParser:
     _view_args(p)
     _shader_args(p)
     p.add_argument("--emit", choices=("program", "library"), default="program",
-                   help="program: a complete shader; library: the functions only")
+                   help="program (default): a complete shader; library: the functions only")
     p.add_argument("--prefix", default="",
-                   help="prefix for every global name (library drop-ins), e.g. cc_")
-    p.add_argument("-o", "--output", type=Path, help="output file (default: stdout)")
+                   help="prefix for every global name (library drop-ins), e.g. cc_ "
+                        "(default: none); an identifier start: no leading digit, no '__', "
+                        "not gl_ for glsl")
+    p.add_argument("-o", "--output", type=Path,
+                   help="output file; its extension gives the target when -t is not given "
+                        "(.frag/.glsl glsl, .wgsl, .cl opencl); - or none: standard output")
     p.add_argument("--validate", action="store_true",
                    help="validate with the language's real compiler before writing")
     p.set_defaults(run=cmd_compile)
 
-    p = sub.add_parser("validate", help="check shader files with their real compilers")
+    p = sub.add_parser("validate", help="check shader files with their real compilers",
+                       description="Compile each file with its language's real compiler, "
+                                   "chosen by extension: .frag .vert .comp .glsl "
+                                   "(glslangValidator), .wgsl (naga), .cl (PoCL). Every file "
+                                   "is read before any compiler runs; exit 3 if one fails.")
     p.add_argument("files", nargs="+", type=Path, metavar="FILE")
     p.add_argument("--stage", choices=("vert", "frag", "comp", "geom", "tesc", "tese"),
                    help="GLSL files only: the shader stage (default: from the extension, "
@@ -265,12 +308,16 @@ def build_parser() -> argparse.ArgumentParser:
     _surface_args(p)
     _view_args(p)
     _shader_args(p)
-    p.add_argument("-b", "--backend", choices=[*BACKENDS, REFERENCE], default="gl",
+    p.add_argument("-b", "--backend", choices=[*BACKENDS, REFERENCE], default=None,
                    help="; ".join([*(f"{name}: {b.about}" for name, b in BACKENDS.items()),
-                                   f"{REFERENCE}: {REFERENCE_ABOUT}"]) + " (default gl)")
-    p.add_argument("--size", type=int, help="square image size in pixels (default 512)")
-    p.add_argument("--width", type=int)
-    p.add_argument("--height", type=int)
+                                   f"{REFERENCE}: {REFERENCE_ABOUT}"])
+                   + " (default: the backend of -t, else gl)")
+    p.add_argument("--size", type=_int_between(1, MAX_IMAGE), metavar="N",
+                   help=f"square image size in pixels, 1 to {MAX_IMAGE} (default 512)")
+    p.add_argument("--width", type=_int_between(1, MAX_IMAGE), metavar="W",
+                   help="image width in pixels; alone, the image is square (W x W)")
+    p.add_argument("--height", type=_int_between(1, MAX_IMAGE), metavar="H",
+                   help="image height in pixels; alone, the image is square (H x H)")
     p.add_argument("-o", "--output", type=Path, required=True,
                    help="out.png (for people) or out.exr (R G B A Z steps); out.json beside it")
     p.set_defaults(run=cmd_render)
@@ -294,7 +341,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "render A against render B (typically the reference).")
     p.add_argument("a", type=Path, metavar="A", help="render to judge (EXR + JSON sidecar)")
     p.add_argument("b", type=Path, metavar="B", help="render to judge it by, e.g. the reference")
-    p.add_argument("--t-tol", type=float, default=None,
+    p.add_argument("--t-tol", type=_positive_number, default=None,
                    help="wrong-root tolerance on t, scene units (default 1e-3)")
     p.add_argument("--json", action="store_true", help="print the metrics as JSON")
     p.set_defaults(run=cmd_compare)
@@ -305,11 +352,11 @@ def build_parser() -> argparse.ArgumentParser:
                                    "figure.png and renders/ into -o DIR.")
     p.add_argument("surfaces", nargs="+", metavar="SURFACE",
                    help="TOML files or bundled example names (e.g. cross-cap miter steiner)")
-    p.add_argument("--size", type=int, default=1024,
+    p.add_argument("--size", type=_int_between(8, MAX_IMAGE), default=1024,
                    help="square image size in pixels (default 1024, the paper's)")
-    p.add_argument("--methods", nargs="+", choices=list(METHODS), metavar="METHOD",
+    p.add_argument("--methods", nargs="+", choices=list(METHOD_NAMES), metavar="METHOD",
                    help="methods to time (default: taylor curvature hessian-approx hessian sign)")
-    p.add_argument("--frames", type=int, default=3,
+    p.add_argument("--frames", type=_int_between(1, 1000), default=3,
                    help="timed frames per cell after 1 warm-up; fps is their median (default 3)")
     p.add_argument("-b", "--backend", choices=list(BACKENDS),
                    default="gl", help="renderer to time (default gl)")
@@ -317,7 +364,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="comma-separated: paper (Table 1 constants), equal (one step for "
                         "all), taylor2 (Eq. 4 consistent), extremum (implc's test); "
                         "default all four")
-    p.add_argument("--equal-step", type=float, default=None,
+    p.add_argument("--equal-step", type=_positive_number, default=None,
                    help="base step of every method in the `equal` configuration (default 0.002)")
     p.add_argument("--exr", action="store_true",
                    help="also write each render as EXR (for `implc compare`; 24 MB at 1024²)")
@@ -338,7 +385,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", type=Path, help="write the Markdown report here")
     p.add_argument("-t", "--targets", nargs="+", choices=list(TARGETS), default=list(TARGETS),
                    help="targets to emit and validate (default: all)")
-    p.add_argument("-j", "--jobs", type=int, default=0,
+    p.add_argument("-j", "--jobs", type=_int_between(0, 64), default=0,
                    help="worker processes (default 0: one per CPU, at most 4)")
     p.add_argument("--rows", help="only these data rows, e.g. 1-20,35")
     p.add_argument("--no-validate", action="store_true", help="emit only; skip the compilers")
@@ -454,11 +501,12 @@ def _number_arg(text: str, low: float, high: float, what: str) -> float:
 
 
 def _shader_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("-t", "--target", choices=list(TARGETS), default="glsl",
-                   help="shader language (default: glsl)")
+    p.add_argument("-t", "--target", choices=list(TARGETS), default=None,
+                   help="shader language (default: glsl; compile: from -o's extension; "
+                        "render: the language of -b)")
     p.add_argument("--flavor", help="; ".join(
         f"{t.name}: {', '.join(t.flavors)} (default {t.default_flavor})"
-        for t in TARGETS.values() if len(t.flavors) > 1))
+        for t in TARGETS.values() if len(t.flavors) > 1) + " (the other targets have none)")
     precisions = dict.fromkeys(x for t in TARGETS.values() for x in t.precisions)
     p.add_argument("--precision", choices=list(precisions), help="; ".join(
         f"{t.name}: {' or '.join(t.precisions)} (default {t.precisions[0]})"
@@ -470,26 +518,35 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
 
 
 def _method_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("-m", "--method", choices=list(METHODS), default=None,
+    p.add_argument("-m", "--method", choices=list(METHOD_NAMES), default=None,
                    help="root-finding method (default: exact for polynomial surfaces up to "
                         f"degree {EXACT_MAX_DEGREE}, else interval where every function has "
                         "an interval rule (not atan2), else hessian); see README \"The "
                         "methods\"")
     d = Constants()
-    c = p.add_argument_group("method constants (defaults: the paper's Table 1)")
-    c.add_argument("--step", type=float, help="base step b (default 0.01; hessian 0.002)")
-    c.add_argument("--tau1", type=float, help=f"|F| <= tau1: near the surface (default {d.tau1})")
-    c.add_argument("--tau2", type=float, help=f"|F| > tau2: far from it (default {d.tau2})")
-    c.add_argument("--tau3", type=float, help=f"|F'| <= tau3: silhouette (default {d.tau3})")
-    c.add_argument("--eps", type=float,
+    c = p.add_argument_group(
+        "method constants (defaults: the paper's Table 1)",
+        "One the method does not read (--step with exact, any with -b reference) is "
+        "ignored with a warning.")
+    c.add_argument("--step", type=_positive_number,
+                   help="base step b (default 0.01; hessian 0.002)")
+    c.add_argument("--tau1", type=_positive_number,
+                   help=f"|F| <= tau1: near the surface (default {d.tau1})")
+    c.add_argument("--tau2", type=_positive_number,
+                   help=f"|F| > tau2: far from it (default {d.tau2})")
+    c.add_argument("--tau3", type=_positive_number,
+                   help=f"|F'| <= tau3: silhouette (default {d.tau3})")
+    c.add_argument("--eps", type=_positive_number,
                    help=f"hessian-approx finite-difference step (default {d.eps})")
     c.add_argument("--taylor2", choices=TAYLOR2_CHOICES,
-                   help="Eq. 4 as printed (paper, default) or consistent (h^2/8, F''(t1))")
-    c.add_argument("--max-steps", type=int, help=f"march step cap per ray (default {d.max_steps})")
+                   help="Eq. 4 as printed (paper, default), consistent (h^2/8, F''(t1)), or "
+                        "extremum (consistent plus each end's extremum inside the step)")
+    c.add_argument("--max-steps", type=_int_between(1, MAX_STEPS),
+                   help=f"march step cap per ray (default {d.max_steps})")
     p.add_argument("--eval", choices=EVAL_CHOICES, help=(
         "how F, F', F'' are computed along a ray: point (3-D functions of p = o + s d), "
-        "ray-poly (polynomial S: the ray polynomial's coefficients once per ray, then Horner), "
-        "auto (default: ray-poly for polynomials up to degree "
+        "ray-poly (polynomial S: the ray polynomial's coefficients once per ray, then "
+        "Estrin's scheme), auto (default: ray-poly for polynomials up to degree "
         f"{AUTO_MAX_DEGREE}, else point); see README \"Evaluation forms\""))
 
 
@@ -507,9 +564,7 @@ LIMIT_FLAGS = {
 }
 
 
-def _default_limits():
-    from .parse import Limits
-
+def _default_limits() -> Limits:
     return Limits()
 
 
@@ -524,9 +579,39 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def _limits(args):
-    from .parse import Limits
+MAX_IMAGE = 8192  # the largest image side, in pixels
+MAX_STEPS = 10_000_000  # the largest --max-steps
 
+
+def _int_between(low: int, high: int):
+    """argparse type: an integer from `low` to `high` (a value outside is a usage error,
+    exit 2; `--size 0` is not "the default")."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(
+                f"expected an integer from {low} to {high}, got {value}")
+        return value
+
+    return parse
+
+
+def _positive_number(text: str) -> float:
+    """argparse type of the method constants and tolerances: 0 < value < 1e6."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value < 1e6:  # also nan and inf
+        raise argparse.ArgumentTypeError(f"expected a positive number below 1e6, got {text!r}")
+    return value
+
+
+def _limits(args) -> Limits:
     given = {flag[2:].replace("-", "_"): getattr(args, flag[2:].replace("-", "_"))
              for flag in LIMIT_FLAGS}
     return Limits(**{k: v for k, v in given.items() if v is not None})
@@ -538,6 +623,9 @@ def _surface(args, aspect: float = 1.0):
     height, when known)."""
     from .surface import load_surface
 
+    if (args.surface is None) == (args.equation is None):
+        raise UsageError("give a surface (a file or a bundled example name) or -e EQUATION"
+                         + (", not both" if args.surface is not None else ""))
     surface = load_surface(args.surface, args.equation, args.param, _limits(args))
     if getattr(args, "view_options", False):
         surface = _with_view(args, surface, aspect)
@@ -550,13 +638,6 @@ _NOTES: list[str] = []  # stderr lines kept until the command succeeds (_print_n
 def _print_notes() -> None:
     while _NOTES:
         print(_NOTES.pop(0), file=sys.stderr)
-
-
-class CommandLineError(InputError):
-    """A bad command line found after parsing (view options that make a view which shows
-    nothing, `--stage` for a WGSL file): exit 2, like argparse's own."""
-
-    exit_code = EXIT_USAGE
 
 
 def _with_view(args, surface, aspect: float):
@@ -580,27 +661,64 @@ def _with_view(args, surface, aspect: float):
     if problems:
         flags = " ".join(VIEW_FLAGS[key] for key in sorted(options.given()))
         if flags:
-            raise CommandLineError(f"{flags}: the view shows nothing: {problems[0][1]}")
+            raise UsageError(f"{flags}: the view shows nothing: {problems[0][1]}")
         raise InputError(f"{surface.origin}: [view] {problems[0][1]}")
     if framing is not None:
         _NOTES.append(framing.message())
     return dataclasses.replace(surface, view=view)
 
 
+# Constants field -> (argparse dest, the option that sets it); ranges are checked by the
+# options' types (a bad value is a usage error)
+CONSTANT_OPTIONS = {
+    "step": ("step", "--step"), "tau1": ("tau1", "--tau1"), "tau2": ("tau2", "--tau2"),
+    "tau3": ("tau3", "--tau3"), "eps": ("eps", "--eps"), "taylor2": ("taylor2", "--taylor2"),
+    "max_steps": ("max_steps", "--max-steps"), "evaluation": ("eval", "--eval"),
+}
+
+
 def _constants(args) -> Constants:
-    method = METHODS[args.method]
-    values = {
-        "step": args.step, "tau1": args.tau1, "tau2": args.tau2, "tau3": args.tau3,
-        "eps": args.eps, "taylor2": args.taylor2, "max_steps": args.max_steps,
-        "evaluation": args.eval,
-    }
-    for key in ("step", "tau1", "tau2", "tau3", "eps"):
-        value = values[key]
-        if value is not None and not 0.0 < value < 1e6:
-            raise InputError(f"--{key} must be a positive number (got {value})")
-    if values["max_steps"] is not None and not 1 <= values["max_steps"] <= 10_000_000:
-        raise InputError("--max-steps must be between 1 and 10000000")
-    return method.constants(**values)
+    from .methods import METHODS
+
+    values = {field: getattr(args, dest) for field, (dest, _) in CONSTANT_OPTIONS.items()}
+    return METHODS[args.method].constants(**values)
+
+
+def _warn(args, message: str) -> None:
+    print(f"implc {args.command}: warning: {message}", file=sys.stderr)
+
+
+def _spoken(flags: list[str]) -> str:
+    """['--step', '--tau1'] -> '--step and --tau1 do'."""
+    listed = flags[0] if len(flags) == 1 else ", ".join(flags[:-1]) + " and " + flags[-1]
+    return listed + (" does" if len(flags) == 1 else " do")
+
+
+def _warn_ignored(args, backend: str | None = None) -> None:
+    """A method constant the method does not read (--step with exact), or any method
+    option with the CPU reference, is said on stderr and ignored (exit 0), never dropped
+    silently (README "Command line"). What a method reads comes from its data
+    (`Method.reads`), not from a list here."""
+    given = [(field, flag) for field, (dest, flag) in CONSTANT_OPTIONS.items()
+             if getattr(args, dest) is not None]
+    if backend == REFERENCE:
+        flags = (["-m"] if args.method_given else []) + [flag for _, flag in given]
+        if args.flavor is not None:
+            flags.append("--flavor")
+        if flags:
+            _warn(args, f"{_spoken(flags)} not apply to -b reference (the exact CPU "
+                        "reference runs no method and no shader): ignored")
+        return
+    from .methods import METHODS
+
+    reads = METHODS[args.method].reads
+    ignored = [flag for field, flag in given if field not in reads]
+    if ignored:
+        which = "" if args.method_given else " (the default for this surface)"
+        used = [flag for field, (_, flag) in CONSTANT_OPTIONS.items() if field in reads]
+        _warn(args, f"{_spoken(ignored)} not apply to method {args.method}{which}, which "
+                    f"reads {', '.join(used) if used else 'none of the method constants'}: "
+                    "ignored")
 
 
 def cmd_list(args) -> int:
@@ -622,11 +740,13 @@ def _resolve_method(args, surface) -> None:
     """-m's default depends on the surface (marcher.default_method)."""
     from .marcher import default_method
 
+    args.method_given = args.method is not None
     if args.method is None:
         args.method = default_method(surface.expr)
 
 
 def cmd_show(args) -> int:
+    from .methods import METHODS
     from .show import describe
 
     surface = _surface(args)
@@ -641,15 +761,46 @@ def shader_extensions(target: str) -> tuple[str, ...]:
     return tuple(ext for ext in TARGETS[target].extensions if ext not in (".vert", ".comp"))
 
 
+def _compile_target(args) -> str:
+    """-t, else the language of -o's extension (read as `implc validate` reads it: `-o
+    x.wgsl` is WGSL), else glsl."""
+    if args.target is not None:
+        return args.target
+    if args.output is None:
+        return "glsl"
+    every = tuple(ext for name in TARGETS for ext in shader_extensions(name))
+    check_output(args.output, every, what="a shader")  # a directory, or no language's
+    return target_of_file(args.output.suffix.lower()).name
+
+
+def _check_shader_options(args, target: Target) -> None:
+    """--flavor, --precision and --prefix against the target: a usage error (exit 2),
+    before any work."""
+    if args.flavor is not None and (problem := flavor_problem(target, args.flavor)):
+        raise UsageError(f"--flavor: {problem}")
+    if args.precision is not None and args.precision not in target.precisions:
+        others = [t.name for t in TARGETS.values() if args.precision in t.precisions]
+        raise UsageError(f"--precision {args.precision}: {target.name} has "
+                         f"{' or '.join(target.precisions)} only ({args.precision}: "
+                         f"{', '.join(others)})")
+    if problem := prefix_problem(args.prefix, target):
+        raise UsageError(problem)
+
+
 def cmd_compile(args) -> int:
+    if args.output is not None and str(args.output) == "-":
+        args.output = None  # `-o -`: standard output
+    args.target = target = _compile_target(args)
+    _check_shader_options(args, TARGETS[target])
+    if args.output:
+        check_output(args.output, shader_extensions(target), what=f"a {target} shader")
     from .emit import emit
 
-    if args.output:
-        check_output(args.output, shader_extensions(args.target),
-                     what=f"a {args.target} shader")
     surface = _surface(args)
     _resolve_method(args, surface)
-    text = emit(surface, args.target, args.method, _constants(args), args.flavor, args.emit,
+    constants = _constants(args)
+    _warn_ignored(args)
+    text = emit(surface, target, args.method, constants, args.flavor, args.emit,
                 args.prefix, precision=args.precision, params=args.params)
     if args.validate:
         from .validate import validate_text
@@ -680,8 +831,7 @@ def cmd_validate(args) -> int:
             raise InputError(f"{path}: unknown shader extension '{path.suffix}' "
                              f"(known: {known})")
         if args.stage and target.name != "glsl":
-            raise CommandLineError(f"--stage applies to GLSL files only; {path} is "
-                                  f"{target.name}")
+            raise UsageError(f"--stage applies to GLSL files only; {path} is {target.name}")
         text = read_input_text(path)
         check_source(text, str(path))
         sources.append((path, target.name, text))
@@ -704,15 +854,46 @@ def read_input_text(path: Path, limit: int = 50_000_000) -> str:
         raise InputError(f"{path}: not UTF-8 text (byte {err.start})") from None
 
 
+def _render_backend(args) -> str:
+    """-b, or the backend of -t's language (`-t wgsl` renders with wgpu), else gl; at
+    --precision's backend (`-b cl --precision double` is cl-double). A contradiction
+    (`-t wgsl -b gl`), or a --flavor the backend does not run, is a usage error."""
+    from .render.run import backend_for
+
+    backend = args.backend
+    if args.target is not None:
+        target = TARGETS[args.target]
+        if backend is None:
+            backend = next(iter(target.backends))
+        elif backend not in target.backends:
+            raise UsageError(f"-t {target.name} renders with -b "
+                             f"{' or '.join(target.backends)}, not -b {backend}")
+    backend = backend or "gl"
+    try:
+        backend = backend_for(backend, args.precision)  # a precision is a backend of its own
+    except InputError as err:
+        raise UsageError(err.message) from None
+    target = next((t for t in TARGETS.values() if backend in t.backends), None)
+    if target is not None and args.flavor is not None:
+        if problem := flavor_problem(target, args.flavor):
+            raise UsageError(f"--flavor: {problem}")
+        if args.flavor != target.default_flavor:  # the program every backend runs
+            raise UsageError(f"--flavor {args.flavor}: -b {backend} renders the "
+                             f"{target.default_flavor} program; the other flavours are for "
+                             "`implc compile`")
+    return backend
+
+
 def cmd_render(args) -> int:
-    from .render.run import backend_for, render_surface
+    from .render.run import render_surface
 
     width, height = _size(args)
-    backend = backend_for(args.backend, args.precision)  # a precision is a backend of its own
+    backend = _render_backend(args)
     check_output(args.output, (".png", ".exr"), what="a render",
                  companions=[args.output.with_suffix(".json")])
     surface = _surface(args, width / height)
     _resolve_method(args, surface)
+    _warn_ignored(args, backend)
     _check_frame(surface, width, height)
     start = time.perf_counter()
     paths, result = render_surface(surface, backend, args.method, _constants(args), width,
@@ -781,6 +962,7 @@ def cmd_view(args) -> int:
     check_output(args.output, (".html", ".htm"), what="the viewer page")
     surface = _surface(args)
     _resolve_method(args, surface)
+    _warn_ignored(args)
     page = viewer_page(surface, args.method, _constants(args), webgpu=not args.no_webgpu)
     write_atomic(args.output, page)
     print(f"wrote {args.output}")
@@ -794,18 +976,24 @@ def cmd_compare(args) -> int:
     from .compare import compare_files, format_metrics
     from .metrics import T_TOL
 
-    t_tol = T_TOL if args.t_tol is None else args.t_tol
-    if not 0.0 < t_tol < 1e6:
-        raise InputError(f"--t-tol must be a positive number (got {t_tol})")
+    t_tol = T_TOL if args.t_tol is None else args.t_tol  # its type checks the range
     metrics = compare_files(args.a, args.b, t_tol)
     print(json.dumps(metrics, indent=2) if args.json else format_metrics(metrics))
     return EXIT_OK
 
 
 def cmd_bench(args) -> int:
-    from .bench import DEFAULT_METHODS, EQUAL_STEP, run_bench
+    from .bench import DEFAULT_METHODS, EQUAL_STEP, make_configs, run_bench
     from .surface import load_surface
 
+    configs = [name.strip() for name in args.configs.split(",") if name.strip()]
+    try:
+        make_configs(configs)
+    except InputError as err:
+        raise UsageError(f"--configs: {err.message}") from None
+    twice = [m for i, m in enumerate(args.methods or ()) if m in args.methods[:i]]
+    if twice:
+        raise UsageError(f"--methods: {twice[0]} is listed twice")
     check_output_dir(args.output, what="bench output directory")
     surfaces = {}
     for spec in args.surfaces:
@@ -813,7 +1001,6 @@ def cmd_bench(args) -> int:
         if key in surfaces:
             raise InputError(f"surface '{key}' is given twice")
         surfaces[key] = load_surface(spec)
-    configs = [name.strip() for name in args.configs.split(",") if name.strip()]
     run_bench(
         surfaces, args.output, size=args.size, methods=args.methods or DEFAULT_METHODS,
         frames=args.frames, backend=args.backend, configs=configs,
@@ -826,6 +1013,7 @@ def cmd_bench(args) -> int:
 def cmd_corpus(args) -> int:
     from . import corpus
 
+    wanted = _row_numbers(args.rows) if args.rows else None  # a usage error first
     if args.output:
         check_output(args.output, (".md",), what="the corpus report (Markdown)")
     tsv = args.tsv or corpus.default_tsv()
@@ -834,8 +1022,7 @@ def cmd_corpus(args) -> int:
                          "give the TSV path (tests/data/corpus_permissive.tsv is a copy of "
                          "its permissively licensed rows)")
     rows = corpus.load_rows(tsv)
-    if args.rows:
-        wanted = _row_numbers(args.rows)
+    if wanted is not None:
         rows = [r for r in rows if r.number in wanted]
     jobs = corpus.effective_jobs(args.jobs)
     from .progress import Progress
@@ -879,7 +1066,7 @@ def _row_numbers(text: str) -> set[int]:
         try:
             first, last = int(low), int(high or low)
         except ValueError:
-            raise InputError(f"--rows: expected numbers like 1-20,35, got {text!r}") from None
+            raise UsageError(f"--rows: expected numbers like 1-20,35, got {text!r}") from None
         numbers.update(range(first, last + 1))
     return numbers
 
@@ -894,13 +1081,10 @@ def _check_frame(surface, width: int, height: int) -> None:
 
 
 def _size(args) -> tuple[int, int]:
-    """--size N, or --width/--height (each defaults to the other, then to 512). A given 0
-    is an error, not "not given"."""
+    """--size N, or --width/--height (each defaults to the other, then to 512). The
+    options' type refuses 0 (an error, not "not given")."""
     if args.size is not None and (args.width is not None or args.height is not None):
-        raise InputError("give --size or --width/--height, not both")
+        raise UsageError("give --size or --width/--height, not both")
     width = next((v for v in (args.width, args.size, args.height) if v is not None), 512)
     height = next((v for v in (args.height, args.size, args.width) if v is not None), 512)
-    for value in (width, height):
-        if not 1 <= value <= 8192:
-            raise InputError(f"image size must be between 1 and 8192 pixels (got {value})")
     return width, height

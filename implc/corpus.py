@@ -143,14 +143,19 @@ def load_rows(path: Path) -> list[Row]:
 
 
 def row_surface(row: Row, limits=None):
-    """The row as `implc compile -e EQUATION --param NAME=repr(float(VALUE)) ...` loads it.
+    """The row as `implc compile -e EQUATION --param NAME=repr(float(VALUE)) ...` loads it,
+    with the parameters its equation names (upstream rows may list more: a family's
+    parameters that this member does not use, which `--param` refuses).
 
     Raises `InputError` with the reason when implc refuses the row.
     """
-    from .surface import load_surface
+    from .surface import equation_words, load_surface
 
     args = []
+    named = equation_words(row.equation)
     for name, value in row.params.items():
+        if name not in named:
+            continue
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise InputError(f"parameter '{name}' has no numeric value in the corpus")
         args.append(f"{name}={float(value)!r}")

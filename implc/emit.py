@@ -25,7 +25,7 @@ from .pieces import build_programs, function_name
 from .resources import data_dir
 from .scene import SHADING, View, light_directions
 from .surface import Surface
-from .targets import get_target
+from .targets import flavor_problem, get_target, prefix_problem
 
 EMITS = ("program", "library")
 PARAM_MODES = ("constant", "uniform")
@@ -71,9 +71,6 @@ def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program"
         else:
             result.append(ParamUniform(name, uniform, uniform, value))
     return result
-
-
-PREFIX_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 
 
 @lru_cache(maxsize=1)
@@ -125,13 +122,11 @@ def emit(
     meth = get_method(method)
     constants = constants or meth.defaults
     flavor = flavor or tgt.default_flavor
-    if flavor not in tgt.flavors:
-        choices = ", ".join(tgt.flavors)
-        raise InputError(f"unknown {target} flavor '{flavor}'; choose from {choices}")
+    problem = flavor_problem(tgt, flavor) or prefix_problem(prefix, tgt)
+    if problem:
+        raise InputError(problem)
     if emit not in EMITS:
         raise InputError(f"unknown emit '{emit}'; choose from {', '.join(EMITS)}")
-    if not set(prefix) <= PREFIX_CHARS or (prefix and prefix[0].isdigit()):
-        raise InputError(f"--prefix must be letters, digits and '_' (got '{prefix}')")
     precision = precision or "float"
     if precision not in tgt.precisions:
         raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")

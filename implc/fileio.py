@@ -66,13 +66,17 @@ def check_output(
     file system or missing permissions show up even for root.
     """
     path = Path(path)
-    if extensions is not None and path.suffix.lower() not in {e.lower() for e in extensions}:
-        known = " or ".join(extensions)
-        shown = f"'{path.suffix}'" if path.suffix else "no extension"
-        raise OutputError(f"cannot write {path}: {what} needs {known}, not {shown}")
-    for target in (path, *companions):
+    for target in (path, *companions):  # first: `-o adir` is a directory, whatever its name
         if target.is_dir():
-            raise OutputError(f"cannot write {target}: it is a directory")
+            example = f"; name a file in it, e.g. {path / ('out' + extensions[0])}" if (
+                extensions and target == path) else ""
+            raise OutputError(f"cannot write {target}: it is a directory{example}")
+    if extensions is not None and path.suffix.lower() not in {e.lower() for e in extensions}:
+        known = " or ".join(extensions) if len(extensions) < 3 else (
+            ", ".join(extensions[:-1]) + " or " + extensions[-1])
+        shown = (f", not '{path.suffix}'" if path.suffix else
+                 f"; '{path.name}' has no extension")
+        raise OutputError(f"cannot write {path}: {what} needs {known}{shown}")
     directory = path.parent if str(path.parent) else Path(".")
     _check_writable_dir(directory, path)
     return path

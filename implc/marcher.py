@@ -46,8 +46,10 @@ from .methods import (
     H,
     Method,
     S,
+    constant_values,
 )
 from .optimize import arrange_by_depth
+from .options import AUTO_MAX_DEGREE, EVAL_CHOICES, EXACT_MAX_DEGREE
 from .pieces import (
     COMPONENT,
     QUANTITY_ORDER,
@@ -60,17 +62,9 @@ from .pieces import (
     sym,
 )
 from .raypoly import carry, coefficient_program, estrin_function, from_ray, ray_name, ray_setup
-from .solver import EXACT_MAX_DEGREE, check_exact, lower_solver
+from .solver import check_exact, lower_solver
 
-FORMS = ("point", "ray-poly")
-EVAL_CHOICES = ("auto", *FORMS)
-# `auto` takes ray-poly for polynomials up to this degree (docs/RESULTS.md, "Evaluation
-# forms"): as accurate as point evaluation at every degree measured (2 to 12), and faster
-# on every bundled polynomial (degree 2 to 6, 3-26 %); above degree 6 the point form was
-# as fast or faster with Horner's F' (sums of n-th powers evaluate cheaply at a point by
-# power chains). With Estrin's F', ray-poly measured as fast or faster up to degree 12 in
-# one run (RESULTS section 2); not re-decided on that alone.
-AUTO_MAX_DEGREE = 6
+# EVAL_CHOICES and AUTO_MAX_DEGREE (`auto`'s rule) are plain data in implc/options.py
 
 # When the root test's inputs are ready, in operations (optimize.arrange_by_depth): the
 # start sample (F0, F0', X0) first, then the step length h (after the step rule), then the
@@ -105,6 +99,16 @@ def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
     if requested != "auto":
         return requested
     return "ray-poly" if degree is not None and degree <= AUTO_MAX_DEGREE else "point"
+
+
+def used_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> str:
+    """The evaluation form `method`'s shader for `expr` uses when `requested` is asked (as
+    `lower` prints it; what a render's sidecar records): the exact solver works on the ray
+    polynomial, the interval method at points, a marcher takes `choose_form`'s."""
+    form = choose_form(expr, requested)
+    if method.solves:
+        return "ray-poly"
+    return "point" if method.bounds else form
 
 
 def default_method(expr: sympy.Expr) -> str:
@@ -251,7 +255,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
 
     used = set().union(*(e.free_symbols for e in (*method.sample, method.step, rule.value,
                                                     *(v for _, v in rule.lets))))
-    values = constants.values()
+    values = constant_values(constants)
     printed = tuple(("real", const_names[c].name, printer.float_literal(values[c]))
                     for c in CONSTANT_SYMBOLS if c in used)
     printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),

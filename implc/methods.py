@@ -17,10 +17,12 @@ sees.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 
 import sympy
 from sympy import Abs, Min, Ne, Piecewise
+
+from .options import TAYLOR2_CHOICES, Constants
 
 # The march parameter along the ray and the length of a step.
 S = sympy.Symbol("s", real=True)
@@ -41,59 +43,10 @@ RAY_QUANTITIES: dict[str, str] = {"F": "S", "dF": "dS", "d2F": "d2S", "lap": "la
 RAY_FUNCTIONS = (F, DF, D2F, LAP)
 
 
-@dataclass(frozen=True)
-class Constants:
-    """Every compile-time option of a marcher; each is a command-line option."""
-
-    step: float = 0.01  # base step b (Eq. 2)
-    tau1: float = 0.01  # |F| <= tau1: near the surface, smaller steps
-    tau2: float = 0.01  # |F| > tau2: far from it, step 2b
-    tau3: float = 0.01  # |F'| <= tau3 near the surface: silhouette, step b/4
-    eps: float = 1e-3  # finite-difference step of hessian-approx along the ray
-    # Eq. 4 as printed ("paper"), "consistent" (h^2/8 and F''(t1) in r), or "extremum"
-    # (consistent, plus the extremum of each end's quadratic model inside the step)
-    taylor2: str = "paper"
-    max_steps: int = 20000  # cap on march steps per ray (a safety bound, not a tuning knob)
-    refine_steps: int = 10  # Newton-bisection iterations on the isolated interval
-    # how the ray quantities are computed: "point", "ray-poly" or "auto" (implc/marcher.py)
-    evaluation: str = "auto"
-    # exact: |F| <= touch * sum |c_k| |u|^k at a critical point u is a touching root, an
-    # order below the float64 reference's own relative tolerance (1e-12 sum |a_k| s^k, its
-    # terms taken from the entry point, ours from the chord's middle): at 1e-12 one Miter
-    # pixel at 1024^2, a ray passing 1e-6 from the z-axis where S >= 0 touches zero
-    # (F's minimum 9e-13), counted as a touch that the reference rejects; 1e-9 and 1e-8
-    # measured 1-2 and 8-16 false hits at 512^2 next to double lines. Newton stops when
-    # its step is below xtol (times 1 + |u|) or after newton_steps iterations (README
-    # "The exact method")
-    touch: float = 1e-13
-    xtol: float = 1e-6
-    # the same for the critical points (roots of F', F'', ...), which only split the ray
-    # into monotonic pieces: placing one off by delta can hide only a pair of roots closer
-    # than delta, a dip of F smaller than |F''| delta^2 / 8 (1e-8 |F''| at 3e-4), below
-    # float32's resolution of F
-    ctol: float = 3e-4
-    # 12: the tail of slow lanes is cut and every degree up to 12 compiles (llvmpipe's
-    # LLVM took minutes on a degree-10 solver at 15 and more)
-    newton_steps: int = 12
-    # the cap of the eager critical-point levels (P_3 .. P_(n-2), which only cut pieces
-    # for the level above; the extremum that decides a touching root keeps newton_steps):
-    # a loop runs as long as its slowest lane, and a lane near a double root of P_k
-    # converges linearly, so the cap is the loop's cost. 8 instead of 12 measured 20-30 %
-    # off the frame at degrees 6-12 with the same counts on every bundled polynomial and
-    # on the degree sweeps but one wrong-root pixel (chmutov 12: 8 against 7 of 65,536);
-    # 6 lost 25 pixels at degree 12
-    crit_steps: int = 8
-
-    def as_dict(self) -> dict:
-        return asdict(self)
-
-    def values(self) -> dict[sympy.Symbol, float]:
-        """The value of each constant symbol."""
-        return {STEP: self.step, TAU1: self.tau1, TAU2: self.tau2, TAU3: self.tau3,
-                EPS: self.eps}
-
-
-TAYLOR2_CHOICES = ("paper", "consistent", "extremum")
+def constant_values(constants: Constants) -> dict[sympy.Symbol, float]:
+    """The value of each constant symbol (Constants is plain data, implc/options.py)."""
+    return {STEP: constants.step, TAU1: constants.tau1, TAU2: constants.tau2,
+            TAU3: constants.tau3, EPS: constants.eps}
 
 
 @dataclass(frozen=True)
@@ -206,6 +159,25 @@ class Method:
     def reads_taylor2(self) -> bool:
         """Whether --taylor2 selects among readings of this method's root test."""
         return not isinstance(self.root, Rule)
+
+    @property
+    def reads(self) -> frozenset[str]:
+        """The command line's method constants (fields of Constants) that this method's
+        shader depends on, from its data: the constant symbols of its sample, step and
+        root expressions (every --taylor2 reading), `taylor2` where the root test has
+        readings, and `max_steps` and `evaluation` for a marcher (the exact solver and
+        the interval bisection print no step cap and choose no evaluation form: see
+        marcher.lower). The command line warns about a constant given outside this."""
+        rules = (self.root,) if isinstance(self.root, Rule) else tuple(self.root.values())
+        exprs = (*self.sample, self.step, *(r.value for r in rules),
+                 *(v for r in rules for _, v in r.lets))
+        used = set().union(*(sympy.sympify(e).free_symbols for e in exprs))
+        fields = {c.name.lower() for c in CONSTANT_SYMBOLS if c in used}
+        if self.reads_taylor2:
+            fields.add("taylor2")
+        if not (self.solves or self.bounds):
+            fields |= {"max_steps", "evaluation"}
+        return frozenset(fields)
 
     def root_rule(self, taylor2: str) -> Rule:
         return self.root if isinstance(self.root, Rule) else self.root[taylor2]

@@ -70,38 +70,11 @@ import sympy
 
 from implc.errors import InputError, LimitError, Source
 from implc.functions import CONSTANTS, USER_FUNCTIONS, Function
+from implc.limits import Limits
 from implc.symbols import X, Y, Z
 
 __all__ = ["Limits", "check_param_name", "fold_constants", "param_symbol", "parse_constant",
            "parse_equation", "parse_equation_with_params", "parse_number"]
-
-
-@dataclass(frozen=True)
-class Limits:
-    """Bounds that keep parsing and every later stage fast; each has a `--max-...` option."""
-
-    # Input length in characters, checked first, on the raw string.
-    max_chars: int = 20_000
-    # Nesting of brackets and operators (parser recursion depth).
-    max_depth: int = 200
-    # AST nodes, and the estimated size of the sympy tree built from them.
-    max_nodes: int = 10_000
-    # |exponent| of a power whose base is not a rational number (x^n, sin(x)^n, pi^n).
-    max_exponent: int = 64
-    # Estimated total degree in x, y, z after expansion (non-polynomial parts count 1).
-    max_degree: int = 40
-    # Estimated number of monomials after full expansion.
-    max_terms: int = 200_000
-    # Decimal exponent bound of number literals: 10^-N <= |literal| <= 10^N unless zero.
-    # float32 shaders cannot represent values far outside this range meaningfully.
-    max_literal_exponent: int = 30
-    # Decimal digits of the numerator or denominator of any rational constant computed
-    # exactly while parsing (literals, folded constants such as 2^100 or 9^9^9); a root
-    # of rational constants, r^(p/q), needs q x digits(r) <= 10 x this.
-    max_constant_digits: int = 300
-    # Estimated size (tree nodes) of the derivatives a marcher needs, before CSE; checked
-    # by implc.derive before differentiating (derivation and CSE time grow with it).
-    max_derived: int = 500_000
 
 
 _WHITESPACE = " \t\n\r"

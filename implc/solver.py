@@ -13,6 +13,7 @@ import sympy
 from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
+from .options import EXACT_MAX_DEGREE
 from .pieces import Code, Marcher, ShaderFunction, build_programs, point_function, printed_lets, sym
 from .raypoly import (
     carry,
@@ -51,12 +52,7 @@ ROBUST_NEWTON_BELOW = 7
 BERNSTEIN_DEPTH = 14
 BERNSTEIN_MAX_NODES = 96
 
-# The exact method's highest degree. Float32 root isolation through the expanded ray
-# polynomial loses accuracy with the degree and the coefficients' size; measured at 512^2
-# (docs/RESULTS.md section 8): 9 bad pixels of 262,144 on the degree-14 knot and 3 on the
-# degree-18 one, 0-5 on the gallery rows of degree 10-12, but thousands on Chmutov's
-# surfaces from degree 13 (coefficients up to 2^(n-1), where every method fails).
-EXACT_MAX_DEGREE = 20
+# EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
 def check_exact(expr: sympy.Expr) -> int:

@@ -120,17 +120,17 @@ def load_surface(
         source = Source("<equation>", equation)
         values = dict(overrides)
         expr, symbolic = _parse(source, values, limits)
+        _check_params_used(equation, overrides, params)
         return Surface("equation", expr, values, View(), symbolic=symbolic)
     path = Path(spec)
     if not path.suffix and not path.exists():
         examples = example_paths()
         if spec not in examples:
-            raise InputError(
-                f"no file or bundled example named '{spec}' (see `implc list`)"
-            )
+            raise InputError(f"no file or bundled example named '{spec}'"
+                             f"{_example_hint(spec, examples)} (see `implc list`)")
         path = examples[spec]
-        return _load_toml(path, overrides, limits, origin=spec)
-    return _load_toml(path, overrides, limits, origin=str(path))
+        return _load_toml(path, overrides, limits, origin=spec, params_args=params)
+    return _load_toml(path, overrides, limits, origin=str(path), params_args=params)
 
 
 def _parse_param_args(params: Sequence[str], limits: Limits) -> dict[str, sympy.Expr]:
@@ -157,7 +157,8 @@ VIEW_KEYS = ("radius", "center", "eye", "target", "up", "fov")
 
 
 def _load_toml(
-    path: Path, overrides: Mapping[str, sympy.Expr], limits: Limits, origin: str
+    path: Path, overrides: Mapping[str, sympy.Expr], limits: Limits, origin: str,
+    params_args: Sequence[str] = (),
 ) -> Surface:
     name = str(path)
     raw = read_input(path, "a surface file")
@@ -208,11 +209,66 @@ def _load_toml(
     values.update(overrides)
     source = where.string_source(("equation",), equation)
     expr, symbolic = _parse(source, values, limits)
+    _check_params_used(equation, overrides, params_args, where, table)
     title = data.get("name", path.stem)
     if not isinstance(title, str):
         raise where.error(("name",), f"name must be a string, not {_toml_type(title)}",
                           value=True)
     return Surface(title, expr, values, _view(where, data.get("view", {})), origin, symbolic)
+
+
+def _example_hint(spec: str, examples: Mapping[str, Path]) -> str:
+    """"; did you mean 'torus'?" for `Torus`, `tourus`; both Barths for `barth`."""
+    by_lower = {name.lower(): name for name in examples}
+    word = spec.lower()
+    close = [by_lower[word]] if word in by_lower else sorted(
+        {*(name for low, name in by_lower.items() if low.startswith(word) or
+           low.replace("-", "") == word.replace("-", "")),
+         *(by_lower[m] for m in difflib.get_close_matches(word, by_lower, n=3, cutoff=0.75))})
+    if not close:
+        return ""
+    quoted = [f"'{name}'" for name in close[:3]]
+    listed = quoted[0] if len(quoted) == 1 else ", ".join(quoted[:-1]) + " or " + quoted[-1]
+    return f"; did you mean {listed}?"
+
+
+# A number or a word, as the equation's tokenizer reads them (implc/parse.py): `1e3` is a
+# number, not the word `e3`; `2R` is 2 and `R`.
+_NUMBER_OR_WORD = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|([A-Za-z_][A-Za-z0-9_]*)",
+                             re.ASCII)
+
+
+def equation_words(equation: str) -> set[str]:
+    """The names an equation's text mentions (parameters, functions, constants, words
+    of x, y, z), read as its tokenizer reads them."""
+    return {m.group(1) for m in _NUMBER_OR_WORD.finditer(equation) if m.group(1)}
+
+
+def _check_params_used(
+    equation: str,
+    overrides: Mapping[str, sympy.Expr],
+    params_args: Sequence[str],
+    where: _TomlMap | None = None,
+    table: Mapping[str, object] | None = None,
+) -> None:
+    """Every `--param` and `[params]` entry must name a parameter the equation uses
+    (after it parsed, so every word of it is a known name): a misspelled `--param q=0.6`
+    would otherwise be ignored without a word. A parameter only inside a constant
+    exponent (`x^n`) counts as used."""
+    words = equation_words(equation)
+    used = sorted(words & ({*overrides, *(table or {})}))
+    its = f" (its parameters: {', '.join(used)})" if used else ", which has no parameters"
+    for arg in params_args:
+        name = arg.partition("=")[0].strip()
+        if name in overrides and name not in words:
+            hint = _hint(name, used)
+            hint_text = f"; did you mean '{hint}'?" if hint else ""
+            raise InputError(f"parameter '{name}' is not in the equation{hint_text}{its}",
+                             Source("--param", arg), arg.index(name), len(name))
+    for key in sorted(table or {}):
+        if key not in words and where is not None:
+            raise where.error(("params", key), f"[params] {key} is not in the equation"
+                                               f"{its}: remove it, or use it")
 
 
 def _parse(source: Source, values: Mapping[str, sympy.Expr], limits: Limits):

@@ -2,7 +2,7 @@
 corpus and the command line's choices and help.
 
 A target is its printer (implc/backends/<name>.py, which also holds its function
-spellings and flavours), its templates (templates/<name>/), the file extensions
+spellings), its templates (templates/<name>/), the file extensions
 `implc validate` reads as its language, the validator that runs its real compiler, the
 render backends that run its program, and its flavours and precisions. Adding a target
 is one record here plus those files (README "Adding a target").
@@ -10,21 +10,17 @@ is one record here plus those files (README "Adding a target").
 Layering (README "Architecture"): the registry sits below emit, which reads the printer,
 templates, flavours and precisions from it. The validator and the runners sit above emit
 (they compile and run what emit writes), so a record names them as "module:function"
-strings, imported by `resolve` when they are called: the registry imports only the
-printers below it, and tests/test_targets.py checks that every reference resolves.
+strings, imported by `resolve` when they are called; the printers too ("module:Class"),
+so that the registry is plain data the command line reads without importing sympy
+(`implc --help` stays fast). tests/test_targets.py checks that every reference resolves.
 """
 
 from __future__ import annotations
 
 import importlib
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-
-from .backends.glsl import FLAVORS as GLSL_FLAVORS
-from .backends.glsl import GlslPrinter
-from .backends.opencl import PRECISIONS as OPENCL_PRECISIONS
-from .backends.opencl import OpenclPrinter
-from .backends.wgsl import WgslPrinter
 
 
 def resolve(reference: str) -> Callable:
@@ -46,10 +42,19 @@ class Backend:
     precision: str = "float"
 
 
+# GLSL flavour -> how the program form is framed (read by templates/glsl/program.glsl.j2)
+GLSL_FLAVORS = {
+    "330": {"version": "330 core", "es": False, "shadertoy": False},
+    "450": {"version": "450 core", "es": False, "shadertoy": False},
+    "es300": {"version": "300 es", "es": True, "shadertoy": False},
+    "shadertoy": {"version": "", "es": False, "shadertoy": True},
+}
+
+
 @dataclass(frozen=True)
 class Target:
     name: str
-    printer: Callable[..., object]  # printer class: (precision) when several, else ()
+    printer_class: str  # "module:Class", the printer: (precision) when several, else ()
     templates: Mapping[str, str]  # emit form (program, library) -> path under templates/
     extensions: tuple[str, ...]  # shader files `implc validate` reads as this language
     validator: str  # "module:function": (text, name) -> validate.Verdict
@@ -63,23 +68,31 @@ class Target:
     # (uniforms, a uniform struct) or "argument" (a Params struct that every function
     # evaluating S takes: OpenCL C has no program-scope variables set at run time)
     params_read_as: str = "global"
+    # name prefixes the language reserves (`--prefix gl_` would write an invalid shader)
+    reserved_prefixes: tuple[str, ...] = ()
+
+    @property
+    def printer(self) -> Callable[..., object]:
+        """The printer class, imported now (it needs sympy)."""
+        return resolve(self.printer_class)
 
 
 TARGETS: dict[str, Target] = {target.name: target for target in (
     Target(
         name="glsl",
-        printer=GlslPrinter,
+        printer_class="implc.backends.glsl:GlslPrinter",
         templates={"program": "glsl/program.glsl.j2", "library": "glsl/library.glsl.j2"},
         extensions=(".frag", ".glsl", ".vert", ".comp"),
         validator="implc.validate:validate_glsl",
         backends={"gl": Backend("implc.render.gl:open_gl_runner",
                                 "GLSL 330 on OpenGL (moderngl, EGL; llvmpipe here)")},
         flavors=GLSL_FLAVORS,
-        default_flavor="330",
+        default_flavor="330",  # also the program the gl backend runs (render/gl.py)
+        reserved_prefixes=("gl_",),
     ),
     Target(
         name="wgsl",
-        printer=WgslPrinter,
+        printer_class="implc.backends.wgsl:WgslPrinter",
         templates={"program": "wgsl/program.wgsl.j2", "library": "wgsl/library.wgsl.j2"},
         extensions=(".wgsl",),
         validator="implc.validate:validate_wgsl",
@@ -90,7 +103,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
     ),
     Target(
         name="opencl",
-        printer=OpenclPrinter,
+        printer_class="implc.backends.opencl:OpenclPrinter",
         templates={"program": "opencl/program.opencl.j2",
                    "library": "opencl/library.opencl.j2"},
         extensions=(".cl",),
@@ -102,8 +115,9 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
                                  "the same in double precision (needs cl_khr_fp64)",
                                  precision="double"),
         },
-        # templates/opencl/ spell double/double2/double3 from `precision`
-        precisions=OPENCL_PRECISIONS,
+        # templates/opencl/ spell double/double2/double3 from `precision`; the printer
+        # checks the same names (backends/opencl.py PRECISIONS)
+        precisions=("float", "double"),
         vector_types=("float", "float2", "float3", "float4"),
         params_read_as="argument",
     ),
@@ -120,3 +134,37 @@ def get_target(name: str) -> Target:
 def target_of_file(suffix: str) -> Target | None:
     """The target whose language a shader file with this extension is written in."""
     return next((t for t in TARGETS.values() if suffix in t.extensions), None)
+
+
+def flavor_problem(target: Target, flavor: str) -> str | None:
+    """Why `flavor` is not one of `target`'s flavours, naming the choices (None: it is)."""
+    if flavor in target.flavors:
+        return None
+    if len(target.flavors) == 1:
+        having = " and ".join(t.name for t in TARGETS.values() if len(t.flavors) > 1)
+        return f"{target.name} has no flavours (--flavor applies to {having} only)"
+    return f"unknown {target.name} flavour '{flavor}'; choose from {', '.join(target.flavors)}"
+
+
+_PREFIX_RE = re.compile(r"[A-Za-z0-9_]*\Z")
+
+
+def prefix_problem(prefix: str, target: Target) -> str | None:
+    """Why `prefix` cannot start every global name of a `target` shader (None: it can).
+
+    It is glued to names (`cc_` + `S`, upper-cased before constants: `CC_STEP`), so it
+    must be an identifier's start; `__` is reserved in GLSL (anywhere in a name), WGSL
+    and OpenCL C (at the start), and a target may reserve prefixes of its own (GLSL:
+    `gl_`)."""
+    if not _PREFIX_RE.match(prefix):
+        return f"--prefix must be letters, digits and '_' (got '{prefix}')"
+    if prefix[:1].isdigit():
+        return (f"--prefix must not start with a digit: names start with it, and a name "
+                f"cannot (got '{prefix}')")
+    if "__" in prefix:
+        return f"--prefix must not contain '__': GLSL reserves such names (got '{prefix}')"
+    for reserved in target.reserved_prefixes:
+        if prefix.startswith(reserved):
+            return (f"--prefix must not start with '{reserved}': {target.name} reserves names "
+                    f"that start with it (got '{prefix}')")
+    return None

@@ -190,8 +190,8 @@ def _one_error_line(proc) -> str:
                            "/nonexistent does not exist"),
     ("OUT/out.txt", "implc: error: cannot write OUT/out.txt: a render needs .png or .exr, "
                     "not '.txt'"),
-    ("OUT/out", "implc: error: cannot write OUT/out: a render needs .png or .exr, "
-                "not no extension"),
+    ("OUT/out", "implc: error: cannot write OUT/out: a render needs .png or .exr; 'out' "
+                "has no extension"),
 ])
 def test_render_output_is_checked_before_rendering(tmp_path, output, message):
     output = output.replace("OUT", str(tmp_path))
@@ -204,7 +204,11 @@ def test_render_output_is_checked_before_rendering(tmp_path, output, message):
 
 @pytest.mark.parametrize(("argv", "message"), [
     (["compile", "sphere", "-o", "OUT/s.txt"],
+     "cannot write OUT/s.txt: a shader needs .frag, .glsl, .wgsl or .cl, not '.txt'"),
+    (["compile", "sphere", "-t", "glsl", "-o", "OUT/s.txt"],
      "cannot write OUT/s.txt: a glsl shader needs .frag or .glsl, not '.txt'"),
+    (["compile", "sphere", "-o", "OUT"],
+     "cannot write OUT: it is a directory; name a file in it, e.g. OUT/out.frag"),
     (["compile", "sphere", "-t", "wgsl", "-o", "OUT/s.frag"],
      "cannot write OUT/s.frag: a wgsl shader needs .wgsl, not '.frag'"),
     (["compile", "sphere", "-o", "OUT/no/such/s.frag"],
@@ -223,14 +227,16 @@ def test_every_output_option_is_checked_first(tmp_path, argv, message):
 
 
 @pytest.mark.parametrize(("size", "message"), [
-    (["--size", "0"], "image size must be between 1 and 8192 pixels (got 0)"),
-    (["--width", "0", "--height", "16"], "image size must be between 1 and 8192 pixels (got 0)"),
-    (["--size", "-3"], "image size must be between 1 and 8192 pixels (got -3)"),
+    (["--size", "0"], "argument --size: expected an integer from 1 to 8192, got 0"),
+    (["--width", "0", "--height", "16"],
+     "argument --width: expected an integer from 1 to 8192, got 0"),
+    (["--size", "-3"], "argument --size: expected an integer from 1 to 8192, got -3"),
 ])
 def test_size_zero_is_an_error_not_the_default(tmp_path, size, message):
+    """A bad command line (exit 2, issue 23), not the default size."""
     proc = implc("render", "sphere", *size, "-o", str(tmp_path / "a.png"))
-    assert proc.returncode == 1
-    assert _one_error_line(proc) == f"implc: error: {message}"
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines()[0] == f"implc render: error: {message}"
     assert list(tmp_path.iterdir()) == []
 
 

@@ -1,4 +1,5 @@
-"""GLSL target: sympy's GLSL printer with implc's shader rules, and its flavours."""
+"""GLSL target: sympy's GLSL printer with implc's shader rules (its flavours are
+implc/targets.py GLSL_FLAVORS)."""
 
 from __future__ import annotations
 
@@ -22,12 +23,3 @@ class GlslPrinter(ShaderPrinterMixin, GLSLPrinter):
 
     def __init__(self):
         super().__init__({"use_operators": True})
-
-
-# flavour -> how the program form is framed (read by templates/glsl/program.glsl.j2)
-FLAVORS = {
-    "330": {"version": "330 core", "es": False, "shadertoy": False},
-    "450": {"version": "450 core", "es": False, "shadertoy": False},
-    "es300": {"version": "300 es", "es": True, "shadertoy": False},
-    "shadertoy": {"version": "", "es": False, "shadertoy": True},
-}

@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from ..errors import InputError
-from ..methods import Constants
-from ..surface import Surface
 from ..targets import TARGETS, Backend, resolve
-from .result import RenderResult
+
+if TYPE_CHECKING:  # the command line reads BACKENDS without sympy or numpy
+    from ..methods import Constants
+    from ..surface import Surface
+    from .result import RenderResult
 
 
 class Runner(Protocol):
@@ -119,9 +121,16 @@ def metadata(
     surface: Surface, backend: str, method: str, constants: Constants, result: RenderResult,
     params: str = "constant",
 ) -> dict:
-    """The JSON sidecar: enough to recompute every pixel's ray and to reproduce the run."""
-    method_json = {"name": REFERENCE} if backend == REFERENCE else {
-        "name": method, **constants.as_dict()}
+    """The JSON sidecar: enough to recompute every pixel's ray and to reproduce the run
+    (`evaluation` is the form the shader used, not `auto`)."""
+    if backend == REFERENCE:
+        method_json = {"name": REFERENCE}
+    else:
+        from ..marcher import used_form
+        from ..methods import get_method
+
+        form = used_form(get_method(method), surface.expr, constants.evaluation)
+        method_json = {"name": method, **constants.as_dict(), "evaluation": form}
     return {
         "surface": {
             "name": surface.name,

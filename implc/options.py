@@ -1,0 +1,83 @@
+"""What the command line offers, as plain data: the method names, the marcher's
+constants, the evaluation forms and the exact method's degree bound.
+
+No sympy or numpy here, so that `implc --help`, `implc COMMAND --help` and `--version`
+start in a fraction of the time the registries take to import (`make startup`). The
+registries that do the work import these from here (methods.py, marcher.py, solver.py);
+tests/test_startup.py checks that the names agree with them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+# The methods of implc/methods.py's METHODS, in its order (the `-m` choices).
+METHOD_NAMES = ("sign", "taylor", "curvature", "hessian", "hessian-approx", "exact", "interval")
+
+# Evaluation forms (implc/marcher.py): how F, F', F'' are computed along a ray.
+FORMS = ("point", "ray-poly")
+EVAL_CHOICES = ("auto", *FORMS)
+# `auto` takes ray-poly for polynomials up to this degree (docs/RESULTS.md, "Evaluation
+# forms"): as accurate as point evaluation at every degree measured (2 to 12), and faster
+# on every bundled polynomial (degree 2 to 6, 3-26 %); above degree 6 the point form was
+# as fast or faster with Horner's F' (sums of n-th powers evaluate cheaply at a point by
+# power chains). With Estrin's F', ray-poly measured as fast or faster up to degree 12 in
+# one run (RESULTS section 2); not re-decided on that alone.
+AUTO_MAX_DEGREE = 6
+
+# The exact method's highest degree. Float32 root isolation through the expanded ray
+# polynomial loses accuracy with the degree and the coefficients' size; measured at 512^2
+# (docs/RESULTS.md section 8): 9 bad pixels of 262,144 on the degree-14 knot and 3 on the
+# degree-18 one, 0-5 on the gallery rows of degree 10-12, but thousands on Chmutov's
+# surfaces from degree 13 (coefficients up to 2^(n-1), where every method fails).
+EXACT_MAX_DEGREE = 20
+
+
+@dataclass(frozen=True)
+class Constants:
+    """Every compile-time option of a marcher; each is a command-line option."""
+
+    step: float = 0.01  # base step b (Eq. 2)
+    tau1: float = 0.01  # |F| <= tau1: near the surface, smaller steps
+    tau2: float = 0.01  # |F| > tau2: far from it, step 2b
+    tau3: float = 0.01  # |F'| <= tau3 near the surface: silhouette, step b/4
+    eps: float = 1e-3  # finite-difference step of hessian-approx along the ray
+    # Eq. 4 as printed ("paper"), "consistent" (h^2/8 and F''(t1) in r), or "extremum"
+    # (consistent, plus the extremum of each end's quadratic model inside the step)
+    taylor2: str = "paper"
+    max_steps: int = 20000  # cap on march steps per ray (a safety bound, not a tuning knob)
+    refine_steps: int = 10  # Newton-bisection iterations on the isolated interval
+    # how the ray quantities are computed: "point", "ray-poly" or "auto" (implc/marcher.py)
+    evaluation: str = "auto"
+    # exact: |F| <= touch * sum |c_k| |u|^k at a critical point u is a touching root, an
+    # order below the float64 reference's own relative tolerance (1e-12 sum |a_k| s^k, its
+    # terms taken from the entry point, ours from the chord's middle): at 1e-12 one Miter
+    # pixel at 1024^2, a ray passing 1e-6 from the z-axis where S >= 0 touches zero
+    # (F's minimum 9e-13), counted as a touch that the reference rejects; 1e-9 and 1e-8
+    # measured 1-2 and 8-16 false hits at 512^2 next to double lines. Newton stops when
+    # its step is below xtol (times 1 + |u|) or after newton_steps iterations (README
+    # "The exact method")
+    touch: float = 1e-13
+    xtol: float = 1e-6
+    # the same for the critical points (roots of F', F'', ...), which only split the ray
+    # into monotonic pieces: placing one off by delta can hide only a pair of roots closer
+    # than delta, a dip of F smaller than |F''| delta^2 / 8 (1e-8 |F''| at 3e-4), below
+    # float32's resolution of F
+    ctol: float = 3e-4
+    # 12: the tail of slow lanes is cut and every degree up to 12 compiles (llvmpipe's
+    # LLVM took minutes on a degree-10 solver at 15 and more)
+    newton_steps: int = 12
+    # the cap of the eager critical-point levels (P_3 .. P_(n-2), which only cut pieces
+    # for the level above; the extremum that decides a touching root keeps newton_steps):
+    # a loop runs as long as its slowest lane, and a lane near a double root of P_k
+    # converges linearly, so the cap is the loop's cost. 8 instead of 12 measured 20-30 %
+    # off the frame at degrees 6-12 with the same counts on every bundled polynomial and
+    # on the degree sweeps but one wrong-root pixel (chmutov 12: 8 against 7 of 65,536);
+    # 6 lost 25 pixels at degree 12
+    crit_steps: int = 8
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+TAYLOR2_CHOICES = ("paper", "consistent", "extremum")
