@@ -50,8 +50,21 @@ def describe(surface: Surface, method: Method) -> str:
         total_before += program.ops_before
         total_after += program.ops_after
     lines.append(f"  total: {total_before} -> {total_after}")
+    if method.bounds:
+        lines += _interval_lines(surface)
     lines += _ray_poly_counts(surface, method, degree)
     return "\n".join(lines)
+
+
+def _interval_lines(surface: Surface) -> list[str]:
+    """What one node of the interval walk evaluates (templates/interval.j2)."""
+    from .interval import derivative_program, range_program
+
+    joint = derivative_program(surface.expr)
+    program = joint or range_program(surface.expr)
+    what = "F and F'" if joint else "F (no monotonic test: F' has no interval rule)"
+    return ["", f"interval: per node, the enclosure of {what} over the segment: "
+                f"{len(program.assignments)} lets"]
 
 
 def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> list[str]:

@@ -152,3 +152,12 @@ def test_a_function_without_a_rule_is_refused(tmp_path, capsys):
     assert "no interval rule for 'atan2'" in capsys.readouterr().err
     with pytest.raises(InputError, match="variable exponent"):
         range_program(sympy.Pow(POINT[0], POINT[1]))
+
+
+def test_show_says_what_a_node_encloses(capsys):
+    assert main(["show", "gyroid", "-m", "interval"]) == 0
+    assert "interval: per node, the enclosure of F and F' over the segment" in \
+        capsys.readouterr().out
+    # sign's derivative is a delta: no F' enclosure, no monotonic test
+    assert main(["show", "-e", "sign(x) + y^2 + z^2 - 1", "-m", "interval"]) == 0
+    assert "no monotonic test" in capsys.readouterr().out
