@@ -29,6 +29,10 @@ The worst cases measured (llvmpipe: LLVM 15.0.6, 256 bits; PoCL 3, pthread, LLVM
 | tan  | (16, 2^-21) | 1.8          | 6.3e-08 | 0.05   | 1.9      | 6.8e-08 | 0.05   |
 | tanh | (16, 2^-21) | 1.8          | 1.4e-07 | 0.18   | 0.7      | 2.0e-08 | 0.02   |
 
+WGSL on lavapipe (wgpu's Vulkan, a compute shader `out[i] = f(xs[i])`) measured as
+llvmpipe to the digit (the same Mesa code generation): budgets 0.04-0.49, asin 0.40,
+acos 0.32, atan 0.49. Chromium's SwiftShader is not measured here.
+
 Mesa's asin, acos and atan are polynomial approximations (largest absolute errors on
 llvmpipe 3.9e-4, 1.6e-4 and 3.4e-6): beyond the (16, 2^-21) these rows first had (budgets
 85, 30 and 1.7), so their absolute part was raised to the least power of two that keeps
@@ -41,8 +45,8 @@ Plain arithmetic, which implc/interval.py takes as IEEE 754 (+, -, * correctly r
 on both targets, and 1/b is within 3 ulps of numpy's (random normal inputs; measured: 1/b
 too is correctly rounded on both, 0 ulps).
 
-Without moderngl's EGL context or PoCL the tests of that backend skip, and fail under
-CI=true (tests/conftest.py).
+Without moderngl's EGL context, PoCL or a wgpu adapter the tests of that backend skip,
+and fail under CI=true (tests/conftest.py).
 """
 
 from __future__ import annotations
@@ -52,6 +56,7 @@ import pytest
 import sympy
 from conftest import require_gl
 from test_opencl import require_opencl
+from test_wgsl import require_wgpu
 
 from implc.backends.glsl import GlslPrinter
 from implc.backends.opencl import OpenclPrinter
@@ -62,7 +67,7 @@ ULP = WIDENING["float"][0]  # 2^-22: the widening's unit, relative
 EPS = 2.0**-23  # float32's epsilon: the unit the measurements are stated in
 WIDTH, HEIGHT = 1024, 256  # the GL framebuffer; N inputs per function
 N = WIDTH * HEIGHT
-BACKENDS = ("gl", "cl")
+BACKENDS = ("gl", "cl", "wgpu")
 X, Y = sympy.symbols("x y", real=True)
 
 # Every row with an interval rule; those in DOMAINS (every row with a nonzero `error`, and
@@ -139,6 +144,18 @@ void main() {
 }
 """
 
+COMPUTE = """@group(0) @binding(0) var<storage, read> xs: array<f32>;
+@group(0) @binding(1) var<storage, read> ys: array<f32>;
+@group(0) @binding(2) var<storage, read_write> out: array<f32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let x = xs[id.x];
+    let y = ys[id.x];
+    out[id.x] = EXPR;
+}
+"""
+
 KERNEL = """__kernel void eval(__global const float *xs, __global const float *ys,
                    __global float *out) {
     size_t i = get_global_id(0);
@@ -209,7 +226,41 @@ def run_cl(expr: sympy.Expr, x: np.ndarray, y: np.ndarray | None = None) -> np.n
     return out
 
 
-RUN = {"gl": run_gl, "cl": run_cl}
+def run_wgpu(expr: sympy.Expr, x: np.ndarray, y: np.ndarray | None = None) -> np.ndarray:
+    """`expr` of x (and y) in a WGSL compute shader on lavapipe (wgpu's Vulkan), one
+    invocation per input, on the device implc renders with (implc/devices.py)."""
+    import wgpu
+
+    from implc.backends.wgsl import WgslPrinter
+    from implc.devices import wgpu_device
+
+    require_wgpu()
+    dev = wgpu_device()
+    source = COMPUTE.replace("EXPR", WgslPrinter().doprint(expr))
+    y = np.zeros_like(x) if y is None else y
+    usage = wgpu.BufferUsage
+    xs = dev.create_buffer_with_data(data=np.ascontiguousarray(x, np.float32),
+                                     usage=usage.STORAGE)
+    ys = dev.create_buffer_with_data(data=np.ascontiguousarray(y, np.float32),
+                                     usage=usage.STORAGE)
+    out = dev.create_buffer(size=4 * x.size, usage=usage.STORAGE | usage.COPY_SRC)
+    pipeline = dev.create_compute_pipeline(
+        layout="auto", compute={"module": dev.create_shader_module(code=source),
+                                "entry_point": "main"})
+    bind = dev.create_bind_group(layout=pipeline.get_bind_group_layout(0), entries=[
+        {"binding": i, "resource": {"buffer": b, "offset": 0, "size": b.size}}
+        for i, b in enumerate((xs, ys, out))])
+    encoder = dev.create_command_encoder()
+    compute = encoder.begin_compute_pass()
+    compute.set_pipeline(pipeline)
+    compute.set_bind_group(0, bind)
+    compute.dispatch_workgroups(-(-x.size // 64))
+    compute.end()
+    dev.queue.submit([encoder.finish()])
+    return np.frombuffer(dev.queue.read_buffer(out), np.float32).copy()
+
+
+RUN = {"gl": run_gl, "cl": run_cl, "wgpu": run_wgpu}
 
 
 # --------------------------------------------------------------------------- the check
