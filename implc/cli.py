@@ -299,7 +299,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "(glslangValidator), .wgsl (naga), .cl (PoCL). Every file "
                                    "is read before any compiler runs; exit 3 if one fails.")
     p.add_argument("files", nargs="+", type=Path, metavar="FILE")
-    p.add_argument("--stage", choices=("vert", "frag", "comp", "geom", "tesc", "tese"),
+    p.add_argument("--stage", choices=list(dict.fromkeys(
+                       stage for t in TARGETS.values() for stage in t.stages)),
                    help="GLSL files only: the shader stage (default: from the extension, "
                         ".vert, .comp, ... or .vert.glsl; .frag and .glsl are frag)")
     p.set_defaults(run=cmd_validate)
@@ -830,7 +831,7 @@ def cmd_validate(args) -> int:
             known = " ".join(sorted(ext for t in TARGETS.values() for ext in t.extensions))
             raise InputError(f"{path}: unknown shader extension '{path.suffix}' "
                              f"(known: {known})")
-        if args.stage and target.name != "glsl":
+        if args.stage and args.stage not in target.stages:
             raise UsageError(f"--stage applies to GLSL files only; {path} is {target.name}")
         text = read_input_text(path)
         check_source(text, str(path))

@@ -171,7 +171,7 @@ class Method:
         rules = (self.root,) if isinstance(self.root, Rule) else tuple(self.root.values())
         exprs = (*self.sample, self.step, *(r.value for r in rules),
                  *(v for r in rules for _, v in r.lets))
-        used = set().union(*(sympy.sympify(e).free_symbols for e in exprs))
+        used = set().union(*(e.free_symbols for e in exprs))
         fields = {c.name.lower() for c in CONSTANT_SYMBOLS if c in used}
         if self.reads_taylor2:
             fields.add("taylor2")

@@ -70,6 +70,9 @@ class Target:
     params_read_as: str = "global"
     # name prefixes the language reserves (`--prefix gl_` would write an invalid shader)
     reserved_prefixes: tuple[str, ...] = ()
+    # the shader stages `implc validate --stage` may choose (a language with one kind of
+    # file, a compute shader or a kernel, has none to choose)
+    stages: tuple[str, ...] = ()
 
     @property
     def printer(self) -> Callable[..., object]:
@@ -89,6 +92,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         flavors=GLSL_FLAVORS,
         default_flavor="330",  # also the program the gl backend runs (render/gl.py)
         reserved_prefixes=("gl_",),
+        stages=("vert", "frag", "comp", "geom", "tesc", "tese"),
     ),
     Target(
         name="wgsl",

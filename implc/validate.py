@@ -93,13 +93,11 @@ def validate_glsl(text: str, name: str = "shader.frag", stage: str | None = None
     stage = stage or glsl_stage(name)
     prelude = 0
     source = text
-    if kind in ("shadertoy", "library"):
+    if kind in ("shadertoy", "library", "plain"):
         prefix = _library_prefix(text) or ""
-        source = render_template("glsl/harness.glsl.j2", kind=kind, body=text, prefix=prefix)
+        source = render_template("glsl/harness.glsl.j2", kind=kind, body=text, prefix=prefix,
+                                 version=PLAIN_GLSL_VERSION)
         prelude = source[: source.index(text)].count("\n")
-    elif kind == "plain":
-        source = f"#version {PLAIN_GLSL_VERSION}\n{text}"
-        prelude = 1
     with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
         path = os.path.join(tmp, f"shader.{stage}")
         Path(path).write_text(source, encoding="utf-8")
@@ -222,6 +220,6 @@ def validate_text(text: str, target: str, name: str, stage: str | None = None) -
     validator = resolve(TARGETS[target].validator)
     if stage is None:
         return validator(text, name)
-    if target != "glsl":
-        raise ValueError(f"a {target} shader has no stage to choose")
+    if stage not in TARGETS[target].stages:
+        raise ValueError(f"a {target} shader has no stage '{stage}' to choose")
     return validator(text, name, stage=stage)
