@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import sympy
 from sympy import Abs, Max, Min, Piecewise
 
+from .derive import Derivatives
 from .errors import InputError
 from .functions import BIG, BY_SYMPY_NAME
 from .pieces import ShaderFunction, sym
@@ -163,9 +164,8 @@ class _Builder:
                 return lo, hi
             if coeff == -1:
                 return -hi, -lo
-            ulps = 1
-            return self.widened(coeff * lo, coeff * hi, ulps) if coeff > 0 else \
-                self.widened(coeff * hi, coeff * lo, ulps)
+            return self.widened(coeff * lo, coeff * hi) if coeff > 0 else \
+                self.widened(coeff * hi, coeff * lo)
         if node.is_Pow:
             return self._pow(node)
         return self._function(node)
@@ -252,13 +252,11 @@ class _Builder:
         return self.widened(lo, hi, ulps, absolute)
 
 
-def derivative_program(expr: sympy.Expr) -> RangeProgram | None:
+def derivative_program(expr: sympy.Expr, max_derived: int | None = None) -> RangeProgram | None:
     """F and F' = grad S . d enclosed jointly over a segment, or None where F may jump
     (sign's derivative is a delta, which has no interval rule): the march's monotonic test
-    then does not apply."""
-    from .derive import Derivatives
-
-    directional = Derivatives(expr, 10**9).quantity("dS")[0]
+    then does not apply. F' is derived under `--max-derived` (default: the current one)."""
+    directional = Derivatives(expr, max_derived).quantity("dS")[0]
     try:
         return range_program(expr, directional)
     except InputError:

@@ -260,14 +260,14 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
                     for c in CONSTANT_SYMBOLS if c in used)
     printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),
                 ("int", prefix.upper() + "REFINE_STEPS", str(int(constants.refine_steps))))
-    monotone = False
+    monotone = False  # (interval: whether FD_range encloses F' too)
     if method.bounds:
-        functions.append(range_function("F_range", range_program(expr), printer, prefix,
+        derivative = derivative_program(expr, max_derived)
+        monotone = derivative is not None
+        functions.append(range_function("FD_range", derivative, printer, prefix, carried)
+                         if monotone else
+                         range_function("F_range", range_program(expr), printer, prefix,
                                         carried))
-        derivative = derivative_program(expr)
-        if derivative is not None:
-            functions[-1] = range_function("FD_range", derivative, printer, prefix, carried)
-            monotone = True
         printed = range_constants(printer, prefix) + printed[-1:]  # and REFINE_STEPS
     return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root,
                    interval=method.bounds, monotone=monotone, carried=carried)
