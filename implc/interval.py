@@ -29,6 +29,7 @@ splits it down to its resolution limit, where the sign test decides.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import sympy
 from sympy import Abs, Max, Min, Piecewise
@@ -85,20 +86,17 @@ def check_interval(expr: sympy.Expr) -> None:
     range_program(expr)
 
 
+@lru_cache(maxsize=64)
 def range_program(*exprs: sympy.Expr) -> RangeProgram:
     """The enclosures of `exprs` over a ray segment, jointly (a subexpression they share
-    is enclosed once), from their trees (see the module's doc)."""
-    if exprs not in _CACHE:
-        builder = _Builder()
-        bounds = [builder.bound(e) for e in exprs]
-        dead = sympy.Or(*builder.dead) if builder.dead else sympy.false
-        if dead is not sympy.false:
-            bounds = [tuple(Piecewise((1, dead), (v, True)) for v in pair) for pair in bounds]
-        _CACHE[exprs] = RangeProgram(tuple(builder.lets), tuple(bounds))
-    return _CACHE[exprs]
-
-
-_CACHE: dict[tuple[sympy.Expr, ...], RangeProgram] = {}
+    is enclosed once), from their trees (see the module's doc). Cached: the default
+    method's check, the lowering and `show` ask for the same program."""
+    builder = _Builder()
+    bounds = [builder.bound(e) for e in exprs]
+    dead = sympy.Or(*builder.dead) if builder.dead else sympy.false
+    if dead is not sympy.false:
+        bounds = [tuple(Piecewise((1, dead), (v, True)) for v in pair) for pair in bounds]
+    return RangeProgram(tuple(builder.lets), tuple(bounds))
 
 
 class _Builder:
