@@ -30,7 +30,6 @@ from .targets import flavor_problem, get_target, prefix_problem
 EMITS = ("program", "library")
 PARAM_MODES = ("constant", "uniform")
 PARAM_UNIFORM_PREFIX = "u_param_"  # parameter R is the uniform u_param_R (README)
-WGSL_PARAM_OFFSET = 76  # byte offset of the first parameter field in the WGSL Uniforms
 
 
 @dataclass(frozen=True)
@@ -43,33 +42,26 @@ class ParamUniform:
     uniform: str
     ref: str
     value: float  # the surface's value (the default a host starts from)
-    offset: int | None = None  # WGSL program: byte offset in struct Uniforms
+    offset: int | None = None  # byte offset in the program's uniform struct, if it has one
 
 
 def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program",
                    prefix: str = "") -> list[ParamUniform]:
     """The parameters of `surface` as uniforms of a `--params uniform` shader, sorted by
     name (parameters only inside constant exponents stay constants, see
-    `Surface.uniform_params`)."""
+    `Surface.uniform_params`), laid out as the target's record says (`ParamLayout`)."""
     result = []
-    argument = get_target(target).params_read_as == "argument"
+    layout = get_target(target).param_layout[emit]
     for i, name in enumerate(surface.uniform_params()):
         uniform = PARAM_UNIFORM_PREFIX + name
         if "__" in uniform:
             raise InputError(f"parameter '{name}' cannot be a shader uniform: names with "
                              "'__' are reserved in GLSL (rename it or use --params constant)")
-        value = float(surface.params[name])
-        if argument:  # a field of the Params struct the functions take
-            result.append(ParamUniform(name, uniform, f"params.{uniform}", value))
-        elif target == "wgsl" and emit == "program":
-            result.append(ParamUniform(name, uniform, f"u.{uniform}", value,
-                                       WGSL_PARAM_OFFSET + 4 * i))
-        elif target == "wgsl":
-            result.append(ParamUniform(name, uniform, f"{prefix}params.{uniform}", value))
-        elif emit == "library":
-            result.append(ParamUniform(name, prefix + uniform, prefix + uniform, value))
-        else:
-            result.append(ParamUniform(name, uniform, uniform, value))
+        names = {"uniform": uniform, "prefix": prefix}
+        offset = None if layout.offset is None else layout.offset + 4 * i
+        result.append(ParamUniform(name, layout.uniform.format(**names),
+                                   layout.ref.format(**names), float(surface.params[name]),
+                                   offset))
     return result
 
 
@@ -156,7 +148,7 @@ def emit(
                     "value": printer.float_literal(u.value),
                     "field": (types["real"], u.uniform, f"parameter {u.name}")}
                    for u in uniforms],
-        "params_struct_size": -(-(WGSL_PARAM_OFFSET + 4 * len(uniforms)) // 16) * 16,
+        "params_struct_size": _struct_size(tgt.param_layout[emit].offset, len(uniforms)),
         "method": meth.name,
         "method_label": label,
         "form": marcher.form,
@@ -173,6 +165,12 @@ def emit(
     }
     template = environment().get_template(tgt.templates[emit])
     return template.render(context)
+
+
+def _struct_size(offset: int | None, count: int) -> int:
+    """Bytes of a uniform struct whose `count` parameters start at `offset`, rounded up to
+    16 (a uniform buffer's alignment); 0 when the parameters are not laid out in bytes."""
+    return 0 if offset is None else -(-(offset + 4 * count) // 16) * 16
 
 
 def render_template(name: str, **context) -> str:

@@ -26,12 +26,8 @@ from pathlib import Path
 
 from .devices import FP64, opencl_build, opencl_device, wgpu_device
 from .errors import InputError, ToolError
-from .targets import TARGETS, resolve, target_of_file
+from .targets import TARGETS, get_target, resolve, target_of_file
 
-# glslangValidator's stages by file extension; any other GLSL file (.frag, .glsl) is a
-# fragment shader unless `--stage` says otherwise or a compound suffix does (`.vert.glsl`)
-GLSL_STAGES = {".vert": "vert", ".frag": "frag", ".comp": "comp", ".geom": "geom",
-               ".tesc": "tesc", ".tese": "tese"}
 PLAIN_GLSL_VERSION = "330"  # for a plain GLSL file without #version
 
 
@@ -67,11 +63,13 @@ def glsl_kind(text: str) -> str:
 
 
 def glsl_stage(name: str) -> str:
-    """The stage of a GLSL file by its extension: `x.vert`, `x.vert.glsl`; else frag."""
+    """The stage of a GLSL file by its extension, named as the target record's stages
+    (`x.vert`, `x.vert.glsl`); any other GLSL file (.frag, .glsl) is a fragment shader
+    unless `--stage` says otherwise."""
     suffixes = Path(name).suffixes
-    if suffixes and suffixes[-1] == ".glsl" and len(suffixes) > 1:
-        return GLSL_STAGES.get(suffixes[-2], "frag")
-    return GLSL_STAGES.get(Path(name).suffix, "frag")
+    suffix = suffixes[-2] if len(suffixes) > 1 and suffixes[-1] == ".glsl" else Path(name).suffix
+    stage = suffix[1:]
+    return stage if stage in get_target("glsl").stages else "frag"
 
 
 def check_source(text: str, name: str) -> None:
