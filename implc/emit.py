@@ -10,7 +10,7 @@ strict: a name a template uses but emit does not give is an error, not an empty 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import jinja2
 import sympy
@@ -65,8 +65,11 @@ def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program"
     return result
 
 
-@lru_cache(maxsize=1)
-def environment() -> jinja2.Environment:
+@cache
+def environment(target: str | None = None) -> jinja2.Environment:
+    """The template environment; for a target, with its printer as the global `printer`,
+    through which templates/<target>/lang.j2 spells select and the table's functions
+    (an imported template sees globals, not the render's context)."""
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(data_dir("templates"))),
         undefined=jinja2.StrictUndefined,
@@ -78,6 +81,8 @@ def environment() -> jinja2.Environment:
     # (abstract type, name) -> (the target's type, name), for function parameters
     env.filters["typed"] = lambda pair, types: (types[pair[0]], pair[1])
     env.filters["typed3"] = lambda field, types: (types[field[0]], *field[1:])
+    if target is not None:
+        env.globals["printer"] = get_target(target).make_printer()
     return env
 
 
@@ -128,7 +133,7 @@ def emit(
     if uniforms and tgt.flavors[flavor].get("shadertoy"):
         raise InputError("the shadertoy flavour has no uniforms of its own: use "
                          "--params constant (the default) with --flavor shadertoy")
-    printer = tgt.printer(precision) if len(tgt.precisions) > 1 else tgt.printer()
+    printer = tgt.make_printer(precision)
     expr, equation = surface.expr, surface.equation
     if uniforms:  # the parameters as symbols named as the shader reads them
         expr = surface.symbolic_expr.xreplace(
@@ -163,7 +168,7 @@ def emit(
         "shading": print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
-    template = environment().get_template(tgt.templates[emit])
+    template = environment(tgt.name).get_template(tgt.templates[emit])
     return template.render(context)
 
 

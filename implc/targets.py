@@ -105,6 +105,10 @@ class Target:
         """The printer class, imported now (it needs sympy)."""
         return resolve(self.printer_class)
 
+    def make_printer(self, precision: str = "float"):
+        """A printer for `precision` (a printer takes one only when there are several)."""
+        return self.printer(precision) if len(self.precisions) > 1 else self.printer()
+
 
 TARGETS: dict[str, Target] = {target.name: target for target in (
     Target(
