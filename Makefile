@@ -9,7 +9,7 @@ OUT := out
 # cannot name, e.g. AMD Zen 5: see implc/render/cl_runner.py device()), Chromium for the
 # browser tests (WebGL2 and WebGPU on SwiftShader, driven by Playwright for Python from the
 # test extras).
-APT_PACKAGES := glslang-tools libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
+APT_PACKAGES := glslang-tools spirv-cross libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
   pocl-opencl-icd chromium
 # three.js for the browser tests, pinned in tests/browser/package-lock.json (npm ci).
 NPM_DIR := tests/browser

@@ -170,6 +170,21 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         param_layout={"program": ParamLayout(ref="params.{uniform}"),
                       "library": ParamLayout(ref="params.{uniform}")},
     ),
+    Target(
+        name="hlsl",
+        printer_class="implc.backends.hlsl:HlslPrinter",
+        templates={"program": "hlsl/program.hlsl.j2", "library": "hlsl/library.hlsl.j2"},
+        emit_extensions={"program": ".hlsl", "library": ".hlsl"},
+        extensions=(".hlsl",),
+        validator="implc.validate:validate_hlsl",
+        backends={"hlsl-spirv": Backend(
+            "implc.render.hlsl_runner:open_hlsl_runner",
+            "HLSL pixel shader through SPIR-V (glslang, spirv-cross) on OpenGL (llvmpipe)",
+            probe="implc.render.hlsl_runner:toolchain")},
+        vector_types=("float", "float2", "float3", "float4"),
+        param_layout={"program": ParamLayout(),
+                      "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
+    ),
 )}
 
 

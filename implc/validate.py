@@ -114,6 +114,34 @@ def validate_glsl(text: str, name: str = "shader.frag", stage: str | None = None
     return Verdict(proc.returncode == 0, tool, output)
 
 
+def validate_hlsl(text: str, name: str = "shader.hlsl") -> Verdict:
+    """Validate HLSL with glslangValidator's HLSL front end, compiled to SPIR-V as a pixel
+    shader with entry point main (`-D -S frag -e main -V`). A library emit has no entry
+    point, so templates/hlsl/harness.hlsl.j2 appends one that calls its functions; the
+    user's text comes first, so the tool's line numbers are the user's."""
+    from .emit import render_template  # late: emit imports the whole pipeline
+
+    tool = find_tool("glslangValidator")
+    source = text
+    if not re.search(r"\bmain\s*\(", text):
+        match = re.search(r"\bbool\s+(\w*)intersect\s*\(", text)
+        source = render_template("hlsl/harness.hlsl.j2", body=text,
+                                 prefix=match.group(1) if match else "")
+    with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
+        path = os.path.join(tmp, "shader.hlsl")
+        Path(path).write_text(source, encoding="utf-8")
+        try:
+            proc = subprocess.run([tool, "-D", "-S", "frag", "-e", "main", "-V",
+                                   "-o", os.path.join(tmp, "shader.spv"), path],
+                                  capture_output=True, text=True, timeout=120)
+        except subprocess.TimeoutExpired:
+            raise ToolError("glslangValidator did not finish within 120 s") from None
+    output = (proc.stdout + proc.stderr).replace(path, name).strip()
+    output = "\n".join(line for line in output.splitlines() if line.strip() != name)
+    return Verdict(proc.returncode == 0, "glslangValidator, HLSL to SPIR-V",
+                   _locate(output, name, 0))
+
+
 def _library_prefix(text: str) -> str | None:
     """The prefix of an implc library emit's entry points (what the harness calls), or
     None when `text` does not define them all (a user's own GLSL)."""
