@@ -28,9 +28,15 @@ def coefficient_program(expr: sympy.Expr) -> Program:
     scheme nested over x, y, z (horner_program), which needs no CSE."""
     if polynomial_degree(expr) is None:
         raise InputError("the ray-poly form needs a polynomial surface")
-    if count_ops(expr) > HORNER_ABOVE:
+    if coefficient_route(expr) == "horner":
         return horner_program(expr)
     return optimize(list(ray_coefficients(expr)), POINT + DIRECTION)
+
+
+def coefficient_route(expr: sympy.Expr) -> str:
+    """"horner" for an equation written out at length, else "tree" (see
+    coefficient_program; `implc show` says which)."""
+    return "horner" if count_ops(expr) > HORNER_ABOVE else "tree"
 
 
 # S's size in operations, as written, above which the ray coefficients come by Horner's

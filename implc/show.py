@@ -8,7 +8,7 @@ from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
 from .marcher import AUTO_MAX_DEGREE, evaluations
 from .methods import Method
-from .raypoly import coefficient_program, ray_quantity_ops
+from .raypoly import HORNER_ABOVE, coefficient_program, coefficient_route, ray_quantity_ops
 from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES
 from .surface import Surface
 from .textform import to_text, value_text
@@ -77,9 +77,10 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
             "",
             "exact (root isolation of the ray polynomial; no marching):",
             f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
-            f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
+            f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries), "
+            + ROUTES[coefficient_route(surface.expr)],
             *_solver_lines(degree),
-            "  F by Horner where its sign is certain, else S at the point",
+            "  F by Estrin's scheme where its sign is certain, else S at the point",
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
@@ -96,6 +97,11 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
         f"F''): "
         f"{per_step or 'none'}; F and {', '.join(point) or 'nothing else'} at the point",
     ]
+
+
+ROUTES = {"tree": "by truncated arithmetic over S's tree as written, jointly CSE'd",
+          "horner": f"by Horner's scheme nested over x, y, z (S is written out at length: "
+                    f"over {HORNER_ABOVE} operations)"}
 
 
 def _short(expr: sympy.Expr, limit: int = 200) -> str:

@@ -173,6 +173,10 @@ def test_show_names_the_solver_strategy():
     assert "strategy: Bernstein subdivision" in describe(high, get_method("exact"))
     low = describe(load_surface("cross-cap"), get_method("exact"))
     assert "strategy: critical points level by level" in low
+    assert "over S's tree as written" in low  # factored: the tree's route
+    written_out = " + ".join(f"{k + 1}x^{k}y^{9 - k - j}z^{j}" for k in range(9) for j in (0, 1))
+    long = describe(load_surface(equation=written_out + " - 1"), get_method("exact"))
+    assert "by Horner's scheme nested over x, y, z" in long
 
 
 @pytest.mark.parametrize("backend", ["gl", "cl"])
@@ -246,3 +250,22 @@ def test_exact_at_degree_20_validates_everywhere(target, flavor, precision, kind
     name = f"degree20.{kind}{TARGETS[target].extensions[0]}"
     verdict = validate_text(text, target, name)
     assert verdict.ok, verdict.render(name)
+
+
+@pytest.mark.parametrize("number", [53, 56])
+def test_exact_holds_on_equations_written_out_at_length(number):
+    """Two SURFER gallery rows written expanded (Labs' septic, degree 7; vielesing,
+    degree 9), whose ray coefficients come by Horner's nested scheme
+    (raypoly.coefficient_route): at 128² on gl, no false hit, missed and wrong-root
+    pixels within 0.1 %. Fails with a Horner step that drops its d-term for the
+    coefficient of s."""
+    from pathlib import Path
+
+    from implc.corpus import load_rows, row_surface
+    from implc.raypoly import coefficient_route
+
+    require_backend("gl")
+    tsv = Path(__file__).parent / "data" / "corpus_permissive.tsv"
+    surface = row_surface(next(r for r in load_rows(tsv) if r.number == number))
+    assert coefficient_route(surface.expr) == "horner"
+    _assert_exact_at_128(surface, "gl", fill=0.05)
