@@ -136,14 +136,18 @@ def _measured_row(first: str, surface, size: int, frames: int) -> tuple[dict, fl
     return r, exact["ms"] / taylor["ms"]
 
 
-def sweep(degrees: list[int], size: int, frames: int, plot: str | None) -> None:
+def sweep(degrees: list[int], size: int, frames: int, plot: str | None,
+          families: list[str] | None = None) -> None:
     """The degree sweep (docs/RESULTS.md): exact against taylor (b = 0.01, both forms;
-    `taylor` in the ratio is the form `auto` picks) and hessian, per family and degree."""
+    `taylor` in the ratio is the form `auto` picks) and hessian, per family and degree
+    (`families`: some of them only)."""
     rows = []
     print(f"| family | degree | {_HEADER}")
     print("|---|---|" + "---|" * 10)
     for degree in degrees:
         for family, equation in sweep_equations(degree).items():
+            if families and family not in families:
+                continue
             surface = load_surface(equation=equation)
             r, ratio = _measured_row(f"{family} | {degree}", surface, size, frames)
             rows.append((family, degree, r, ratio))
@@ -230,6 +234,8 @@ def main() -> None:
     ap.add_argument("--methods", nargs="+", default=["taylor", "hessian"])
     ap.add_argument("--degrees", default="2-20")
     ap.add_argument("--plot")
+    ap.add_argument("--families", nargs="+", choices=("powers", "chmutov"),
+                    help="sweep: these families only (default both)")
     ap.add_argument("--from-table", help="sweep: redraw --plot from this printed table "
                     "instead of measuring")
     args = ap.parse_intermixed_args()
@@ -242,7 +248,7 @@ def main() -> None:
             _plot(rows_from_table(args.from_table), args.size, args.plot)
             return
         lo, hi = (int(v) for v in args.degrees.split("-"))
-        sweep(list(range(lo, hi + 1)), args.size, args.frames, args.plot)
+        sweep(list(range(lo, hi + 1)), args.size, args.frames, args.plot, args.families)
 
 
 if __name__ == "__main__":
