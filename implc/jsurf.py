@@ -21,7 +21,8 @@ sphere of clipping space. A perspective camera (`PERSPECTIVE_CAMERA`) is implc's
 (`ORTHOGRAPHIC_CAMERA`, `camera_height` tall) has no implc counterpart: it becomes a
 perspective camera ORTHO_DISTANCE clip radii away whose field of view is that height at
 the clip sphere's centre (picture scale within 1/ORTHO_DISTANCE across the sphere); the
-writer turns a view narrower than ORTHO_MAX_FOV degrees back into an orthographic camera.
+writer turns a view whose eye is ORTHO_MIN_DISTANCE clip radii or more from its target
+back into an orthographic camera.
 """
 
 from __future__ import annotations
@@ -48,7 +49,8 @@ from .symbols import X, Y, Z
 # an orthographic camera's eye, in clip radii from the target (at 1000 float32 shaders
 # speckle: the eye is too far for the entry point's precision)
 ORTHO_DISTANCE = 100.0
-ORTHO_MAX_FOV = 1.0  # degrees: the writer's orthographic cameras are narrower than this
+# the writer's orthographic cameras: an eye this many clip radii or more from the target
+ORTHO_MIN_DISTANCE = ORTHO_DISTANCE / 2.0
 
 # jsurf's one-argument functions (DoubleUnaryOperation.Op) and what implc calls them;
 # None: implc has no such function.
@@ -427,7 +429,10 @@ def _surface(props: Properties, path: Path, overrides: Mapping[str, sympy.Expr],
 
 
 def _ignored_name(key: str) -> str:
-    return "light_*" if key.startswith("light_") else key
+    """One name for a group: `light_*`, `*_material_shininess` for front and back."""
+    if key.startswith("light_"):
+        return "light_*"
+    return re.sub(r"^(front|back)_material_", "*_material_", key)
 
 
 def _floats(props: Properties, key: str, count: int) -> list[float] | None:
@@ -551,6 +556,15 @@ class _JsurfPrinter(StrPrinter):
             return repr(float(expr))
         return f"{expr.p}/{expr.q}" if expr.q != 1 else str(expr.p)
 
+    def _print_Mul(self, expr):
+        """A long decimal coefficient (a parameter's 0.5067166) as that decimal, not as
+        a fraction of 15-digit integers."""
+        coeff, rest = expr.as_coeff_Mul()
+        if coeff.is_Rational and coeff.q > 1000 and rest != 1:
+            sign = "-" if coeff < 0 else ""
+            return f"{sign}{repr(float(abs(coeff)))}*{self.parenthesize(rest, 50, strict=True)}"
+        return super()._print_Mul(expr)
+
     def _print_Pi(self, expr):
         return repr(math.pi)
 
@@ -589,7 +603,7 @@ def to_jsurf(surface: Surface) -> str:
     basis = np.column_stack([right, up, -forward])  # camera x, y, z in the world
     center = np.asarray(view.clip_center, dtype=np.float64)
     props: dict[str, str] = {}
-    if view.fov_y_deg < ORTHO_MAX_FOV:
+    if float(np.linalg.norm(target - eye)) >= ORTHO_MIN_DISTANCE * radius:
         # a narrow view is the reader's orthographic camera: eye on the axis one clip
         # radius from the axis point nearest the centre, as SURFER writes it
         axis_point = eye + forward * float(np.dot(center - eye, forward))
@@ -643,10 +657,10 @@ _SURFER_LIGHTS = (("ON", "-100.0 100.0 100.0", "0.5"), ("ON", "100.0 100.0 100.0
 
 
 def _num(value: float) -> str:
-    value = float(value)
-    if value == 0.0:
-        return "0.0"
-    return repr(round(value, 15) if abs(value) > 1e-12 else value)
+    """15 significant digits (what survives a round trip through the matrices), and a
+    rounding residue below 1e-12 as 0."""
+    value = float(f"{float(value):.15g}")
+    return "0.0" if abs(value) < 1e-12 else repr(value)
 
 
 def _matrix_text(m: np.ndarray) -> str:
