@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 import sympy
 
-from implc.errors import InputError
 from implc.jsurf import ORTHO_DISTANCE, to_jsurf
 from implc.parse import param_symbol
 from implc.scene import SHADING, camera_basis
@@ -74,8 +73,8 @@ def test_orthographic_sphere_framing():
     """kugel.jsurf: a unit sphere, clip radius s = 10^0.15, camera_height 2 (the view is
     s tall): its picture is a disc of diameter 1/s of the frame, pi/(4 s^2) of the
     pixels. The far perspective camera must give that within 2 %."""
-    from implc.render.run import render
     from implc.methods import get_method
+    from implc.render.run import render
 
     surface = load_surface(str(DATA / "kugel.jsurf"))
     s = 10.0 ** 0.15
