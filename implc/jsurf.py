@@ -416,7 +416,7 @@ def _surface(props: Properties, path: Path, overrides: Mapping[str, sympy.Expr],
                              f"{listed})", Source("--param", arg), 0, len(pname))
     values.update(overrides)
     expr, symbolic = parse_equation_with_params(source, values, limits)
-    view = _view(props)
+    view, off_axis = _view(props)
     problems = view_problems(view)
     if problems:
         raise props.file_error(f"the view shows nothing: {problems[0][1]}")
@@ -424,6 +424,11 @@ def _surface(props: Properties, path: Path, overrides: Mapping[str, sympy.Expr],
                        if k in KNOWN_KEYS and k not in USED_KEYS})
     notes = (f"implc: note: {props.name}: ignored (implc does not use them): "
              f"{', '.join(ignored)}",) if ignored else ()
+    if off_axis:
+        notes += (f"implc: note: {props.name}: jsurf 0.4.1 draws this PERSPECTIVE_CAMERA "
+                  "beside what it looks at (its window spans 1 to 3 times tan(fov/2) up "
+                  "and right of the axis); implc draws the camera's centred view, as "
+                  "jsurf's code means it (README \"SURFER files\")",)
     return Surface(path.stem, expr, values, view, str(path),
                    symbolic if values else None, notes)
 
@@ -476,7 +481,8 @@ def _color(props: Properties, key: str) -> tuple[float, float, float] | None:
     return (values[0], values[1], values[2])
 
 
-def _view(props: Properties) -> View:
+def _view(props: Properties) -> tuple[View, bool]:
+    """The view, and whether it is a perspective camera jsurf 0.4.1 draws off its axis."""
     scale = _floats(props, "scale_factor", 1)
     surface_m = _matrix(props, "surface_transform_matrix") @ np.diag(
         [10.0 ** (scale[0] if scale else 0.0)] * 3 + [1.0])
@@ -502,14 +508,21 @@ def _view(props: Properties) -> View:
         hint = f"; did you mean '{close[0]}'?" if close else ""
         raise props.value_error(type_entry, f"camera_type must be ORTHOGRAPHIC_CAMERA or "
                                             f"PERSPECTIVE_CAMERA{hint}")
-    # the point of the camera's axis nearest the clip sphere's centre
-    axis_point = eye + fwd * float(np.dot(center - eye, fwd))
+    off_axis = False
     if camera_type == "PERSPECTIVE_CAMERA":
         fov = _floats(props, "camera_fov_y", 1)
         fov_y = fov[0] if fov else 60.0
+        window = _jsurf041_window(to_surface[:3, :3], fov_y)
+        if window is None:
+            off_axis = True  # draw the camera's own centred frustum (jsurf's intent)
+        else:
+            forward, up, fov_y = window
+            fwd = forward / np.linalg.norm(forward)
         ahead = float(np.dot(center - eye, fwd))
-        target = axis_point if ahead > 1e-9 * radius else eye + fwd * radius
+        target = eye + fwd * ahead if ahead > 1e-9 * radius else eye + fwd * radius
     else:
+        # the point of the camera's axis nearest the clip sphere's centre
+        axis_point = eye + fwd * float(np.dot(center - eye, fwd))
         height = _floats(props, "camera_height", 1)
         half = (height[0] if height else 2.0) / 2.0 * float(np.linalg.norm(up))
         if not half > 0.0:
@@ -519,11 +532,46 @@ def _view(props: Properties) -> View:
         eye = axis_point - fwd * distance
         target = axis_point
         fov_y = math.degrees(2.0 * math.atan(half / distance))
-    return View(eye=_vec(eye), target=_vec(target), up=_vec(up / np.linalg.norm(up)),
+    view = View(eye=_vec(eye), target=_vec(target), up=_vec(up / np.linalg.norm(up)),
                 fov_y_deg=fov_y, clip_center=_vec(center), clip_radius=radius,
                 front=_color(props, "front_material_color"),
                 back=_color(props, "back_material_color"),
                 given=frozenset(("radius", "center", "eye", "target", "up", "fov")))
+    return view, off_axis
+
+
+def _jsurf041_tan(fov_y: float) -> float:
+    """tan(fov_y/2) as jsurf computes it (a float)."""
+    return float(np.float32(math.tan(math.radians(fov_y) / 2.0)))
+
+
+def _jsurf041_window(linear: np.ndarray, fov_y: float) -> tuple[np.ndarray, np.ndarray,
+                                                                 float] | None:
+    """The frustum jsurf 0.4.1 draws for a perspective camera (square picture, as jsurf
+    and SURFER draw), as (forward, up, fov_y) in surface space, when it is a centred one;
+    None when it is not (then jsurf draws beside what the camera looks at).
+
+    jsurf's PerspectiveCameraRayCreator spans its picture from (t, t, -1) to (3t, 3t, -1)
+    in camera space (t = tan(fov_y/2); its corner should be (-t, -t, -1)), so its
+    picture is centred only when `camera_transform` shears that window back onto the
+    axis, as `to_jsurf` writes it. `linear`: camera space to surface space.
+    """
+    t = _jsurf041_tan(fov_y)
+    centre = linear @ np.array([2.0 * t, 2.0 * t, -1.0])
+    across = linear @ np.array([2.0 * t, 0.0, 0.0])
+    up = linear @ np.array([0.0, 2.0 * t, 0.0])
+    width, height = float(np.linalg.norm(across)), float(np.linalg.norm(up))
+    # the centre ray's offset from the window's middle, in half-windows (0 when
+    # centred, 2 for an unsheared camera; SURFER's float rotations leave ~1e-5)
+    offset = max(abs(2.0 * float(np.dot(centre, across))) / width ** 2,
+                 abs(2.0 * float(np.dot(centre, up))) / height ** 2)
+    square = abs(float(np.dot(across, up))) / (width * height) < 1e-3 and \
+        abs(width / height - 1.0) < 1e-3
+    if offset > 1e-2 or not square:
+        return None
+    drawn = math.degrees(2.0 * math.atan(height / 2.0 / float(np.linalg.norm(centre))))
+    # camera_fov_y itself when the window is its own (float rotations aside)
+    return centre, up, fov_y if abs(drawn / fov_y - 1.0) < 1e-4 else drawn
 
 
 def _vec(v) -> tuple[float, float, float]:
@@ -622,6 +670,12 @@ def to_jsurf(surface: Surface) -> str:
     rotation[:3, :3] = basis
     camera = np.eye(4)
     camera[:3, 3] = -(basis.T @ camera_eye)
+    if props["camera_type"] == "PERSPECTIVE_CAMERA":
+        # shear jsurf 0.4.1's off-axis window onto the axis (_jsurf041_window)
+        t = _jsurf041_tan(float(props["camera_fov_y"]))
+        shear = np.eye(4)
+        shear[0, 2] = shear[1, 2] = -2.0 * t
+        camera = shear @ camera
     translate = np.eye(4)
     translate[:3, 3] = center
     props["surface_equation"] = equation

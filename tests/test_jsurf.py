@@ -36,7 +36,7 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 
 
 def test_the_data_files_are_there():
-    assert len(FILES) == 5
+    assert len(FILES) == 6
 
 
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
@@ -47,7 +47,9 @@ def test_reads_gallery_file(path):
     scale = float(text.split("scale_factor=")[1].split()[0])
     assert surface.view.clip_radius == pytest.approx(10.0 ** scale)
     assert surface.view.front is not None and surface.view.back is not None
-    assert len(surface.notes) == 1 and "light_*" in surface.notes[0]
+    assert "light_*" in surface.notes[0]
+    # cayley_cubic's perspective camera is one jsurf 0.4.1 draws off its axis
+    assert len(surface.notes) == (2 if path.stem == "cayley_cubic" else 1)
 
 
 def test_properties_syntax():
@@ -83,6 +85,41 @@ def test_orthographic_sphere_framing():
     assert float(result.hit.mean()) == pytest.approx(expected, rel=0.02)
     eye = np.asarray(surface.view.eye)
     assert np.linalg.norm(eye) == pytest.approx(ORTHO_DISTANCE * s, rel=1e-6)
+
+
+def test_perspective_sphere_framing():
+    """kugel_perspective.jsurf: the unit sphere seen from D = 2 clip radii (2 s) with a
+    60 degree camera in the form jsurf 0.4.1 draws centred (camera_transform shears its
+    off-axis window back onto the axis): a disc of radius tan(asin(1/D)) / tan(30 deg)
+    of the half-height. Measured with jsurf 0.4.1 itself: 33.50 % at 256x256."""
+    from implc.methods import get_method
+    from implc.render.run import render
+
+    surface = load_surface(str(DATA / "kugel_perspective.jsurf"))
+    s = 10.0 ** 0.15
+    rho = math.tan(math.asin(1.0 / (2.0 * s))) / math.tan(math.radians(30.0))
+    result = render(surface, "reference", "exact", get_method("exact").defaults, 96, 96)
+    assert float(result.hit.mean()) == pytest.approx(math.pi * rho * rho / 4.0, rel=0.02)
+    assert np.linalg.norm(surface.view.eye) == pytest.approx(2.0 * s, rel=1e-6)  # 8 digits
+    assert surface.view.fov_y_deg == 60.0
+    assert len(surface.notes) == 1  # the lights; no off-axis note
+
+
+def test_perspective_export_shears_the_window(tmp_path):
+    """A perspective view is written in the form jsurf 0.4.1 draws centred: its
+    camera_transform maps the window jsurf spans, (t, t, -1) to (3t, 3t, -1), onto the
+    centred one, (-t, -t, -1) to (t, t, -1)."""
+    from implc.jsurf import Properties, _jsurf041_tan, _matrix
+
+    text = to_jsurf(load_surface("torus"))
+    props = Properties("torus.jsurf", text)
+    fov = float(props.entries["camera_fov_y"].value)
+    t = _jsurf041_tan(fov)
+    inverse = np.linalg.inv(_matrix(props, "camera_transform"))
+    corner = inverse @ np.array([t, t, -1.0, 1.0]) - inverse @ np.array([0, 0, 0, 1.0])
+    far = inverse @ np.array([3 * t, 3 * t, -1.0, 1.0]) - inverse @ np.array([0, 0, 0, 1.0])
+    np.testing.assert_allclose(corner[:3], [-t, -t, -1.0], atol=1e-12)
+    np.testing.assert_allclose(far[:3], [t, t, -1.0], atol=1e-12)
 
 
 def _rays(view):
