@@ -17,7 +17,9 @@ The view (README "SURFER files"): jsurf maps camera space to its clipping space 
 `transform_matrix * rotation_matrix * camera_transform^-1` and clipping space to the
 surface's by `surface_transform_matrix * 10^scale_factor`; the clip sphere is the unit
 sphere of clipping space. A perspective camera (`PERSPECTIVE_CAMERA`) is implc's camera
-(eye at the camera's origin, looking down -z, `camera_fov_y`). An orthographic one
+(eye at the camera's origin, `camera_fov_y`), looking where jsurf 0.4.1 draws when that
+is a centred frustum (`_jsurf041_window`: jsurf's window is off-axis, a sheared
+`camera_transform` centres it, and the writer writes that), else down -z. An orthographic one
 (`ORTHOGRAPHIC_CAMERA`, `camera_height` tall) has no implc counterpart: it becomes a
 perspective camera ORTHO_DISTANCE clip radii away whose field of view is that height at
 the clip sphere's centre (picture scale within 1/ORTHO_DISTANCE across the sphere); the
