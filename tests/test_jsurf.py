@@ -254,3 +254,33 @@ def test_gallery(tmp_path):
     assert not (out / "broken.png").exists()
     assert (out / "contact-sheet.png").stat().st_size > 0
     assert "[3/3]" in proc.stderr  # progress lines (a bar with ETA on a terminal)
+
+
+def test_gallery_page_in_chromium(browser, tmp_path):
+    """index.html as a browser shows it: every thumbnail loads at its size, every link
+    points at a file the run wrote, and a thumbnail opens its `implc view` page."""
+    from urllib.parse import unquote, urlparse
+
+    from browser_support import file_url, open_page
+
+    bad = tmp_path / "broken.jsurf"
+    bad.write_text("surface_equation=x^2+2y^2-1\n")
+    out = tmp_path / "gal"
+    proc = run("gallery", "torus", str(DATA / "kugel_perspective.jsurf"), str(bad),
+               "--size", "32", "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    with open_page(browser, file_url(out / "index.html")) as (page, log):
+        page.wait_for_load_state("load")
+        images = page.eval_on_selector_all(
+            "img", "els => els.map(e => [e.getAttribute('src'), e.complete, e.naturalWidth])")
+        assert sorted(images) == [["kugel_perspective.png", True, 32], ["torus.png", True, 32]]
+        links = page.eval_on_selector_all("a", "els => els.map(e => e.href)")
+        assert len(links) == 4
+        for link in links:
+            assert link.startswith("file://"), link
+            assert Path(unquote(urlparse(link).path)).is_file(), link
+        page.click("#torus a >> nth=0")
+        page.wait_for_load_state("load")
+        assert page.url.endswith("/torus.html")
+        assert page.title() == "Torus \u2014 implc view"
+        assert not log.exceptions, log.exceptions
