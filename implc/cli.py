@@ -55,7 +55,8 @@ from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
 from .targets import TARGETS, Target, flavor_problem, prefix_problem, target_of_file
 
 EPILOG = """\
-surfaces: a TOML file, a bundled example name (see `implc list`), or -e "EQUATION".
+surfaces: a TOML file, a SURFER .jsurf file, a bundled example name (see `implc list`),
+or -e "EQUATION".
 
 examples:
   implc list
@@ -280,8 +281,9 @@ def build_parser() -> argparse.ArgumentParser:
     _surface_args(p)
     _view_args(p)
     _shader_args(p)
-    p.add_argument("--emit", choices=("program", "library"), default="program",
-                   help="program (default): a complete shader; library: the functions only")
+    p.add_argument("--emit", choices=("program", "library", "jsurf"), default="program",
+                   help="program (default): a complete shader; library: the functions only; "
+                        "jsurf: the surface and its view as a SURFER/jsurf .jsurf file")
     p.add_argument("--prefix", default="",
                    help="prefix for every global name (library drop-ins), e.g. cc_ "
                         "(default: none); an identifier start: no leading digit, no '__', "
@@ -394,11 +396,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-check", action="store_true", help="skip the numeric checks")
     _limit_args(p)
     p.set_defaults(run=cmd_corpus)
+
+    p = sub.add_parser("gallery", help="a contact sheet of many surfaces (index.html)",
+                       description="Render each surface as a thumbnail with its default "
+                                   "method and write index.html (name, equation, degree, "
+                                   "method, frame time; each thumbnail links to the "
+                                   "surface's `implc view` page), contact-sheet.png and "
+                                   "the pages into -o DIR. A surface that fails shows its "
+                                   "error in its cell.")
+    p.add_argument("surfaces", nargs="+", metavar="SURFACE",
+                   help="TOML or .jsurf files or bundled example names")
+    p.add_argument("--size", type=_int_between(8, 1024), default=160,
+                   help="thumbnail side in pixels (default 160)")
+    p.add_argument("-b", "--backend", choices=[b for b in BACKENDS if b != REFERENCE],
+                   default="gl", help="renderer of the thumbnails (default gl)")
+    p.add_argument("--webgpu", action="store_true",
+                   help="give the view pages the WebGPU program too (slower to write)")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
+                   help="output directory (created if missing)")
+    p.set_defaults(run=cmd_gallery)
     return parser
 
 
 def _surface_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("surface", nargs="?", help="TOML file or bundled example name")
+    p.add_argument("surface", nargs="?",
+                   help="TOML file, SURFER .jsurf file or bundled example name")
     p.add_argument("-e", "--equation", help='equation text instead of a file, e.g. "x^2+y^2+z^2=1"')
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="set a named parameter (repeatable)")
@@ -634,6 +656,8 @@ def _surface(args, aspect: float = 1.0):
         raise UsageError("give a surface (a file or a bundled example name) or -e EQUATION"
                          + (", not both" if args.surface is not None else ""))
     surface = load_surface(args.surface, args.equation, args.param, _limits(args))
+    for note in surface.notes:  # a .jsurf file's keys implc does not use, said once
+        print(note, file=sys.stderr)
     if getattr(args, "view_options", False):
         surface = _with_view(args, surface, aspect)
     return surface
@@ -797,6 +821,8 @@ def _check_shader_options(args, target: Target) -> None:
 def cmd_compile(args) -> int:
     if args.output is not None and str(args.output) == "-":
         args.output = None  # `-o -`: standard output
+    if args.emit == "jsurf":
+        return _compile_jsurf(args)
     args.target = target = _compile_target(args)
     _check_shader_options(args, TARGETS[target])
     if args.output:
@@ -821,6 +847,33 @@ def cmd_compile(args) -> int:
         write_atomic(args.output, text)
     else:
         sys.stdout.write(text)
+    return EXIT_OK
+
+
+def _compile_jsurf(args) -> int:
+    """`compile --emit jsurf`: the surface, its view and colours as a .jsurf file (the
+    shader options do not apply)."""
+    from .jsurf import to_jsurf
+
+    if args.output:
+        check_output(args.output, (".jsurf",), what="a .jsurf file")
+    text = to_jsurf(_surface(args))
+    if args.output:
+        write_atomic(args.output, text)
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
+
+
+def cmd_gallery(args) -> int:
+    from .gallery import run_gallery
+
+    check_output_dir(args.output, what="gallery output directory")
+    cells = run_gallery(args.surfaces, args.output, size=args.size, backend=args.backend,
+                        webgpu=args.webgpu)
+    failed = sum(1 for cell in cells if cell.error)
+    print(f"wrote {args.output / 'index.html'} ({len(cells)} surfaces"
+          + (f", {failed} failed: see their cells" if failed else "") + ")")
     return EXIT_OK
 
 
@@ -1008,6 +1061,8 @@ def cmd_bench(args) -> int:
         if key in surfaces:
             raise InputError(f"surface '{key}' is given twice")
         surfaces[key] = load_surface(spec)
+        for note in surfaces[key].notes:
+            print(note, file=sys.stderr)
     run_bench(
         surfaces, args.output, size=args.size, methods=args.methods or DEFAULT_METHODS,
         frames=args.frames, backend=args.backend, configs=configs,

@@ -23,7 +23,7 @@ from .optimize import Program
 from .parse import param_symbol
 from .pieces import build_programs, function_name
 from .resources import data_dir
-from .scene import SHADING, View, light_directions
+from .scene import SHADING, View, light_directions, shading_for
 from .surface import Surface
 from .targets import flavor_problem, get_target, prefix_problem
 
@@ -193,6 +193,7 @@ def _types(tgt, precision: str, prefix: str) -> dict:
 
 def print_shading(view: View, printer) -> dict:
     f = printer.float_literal
+    shading = shading_for(view)
 
     def vec(v) -> list[str]:
         return [f(x) for x in v]
@@ -202,8 +203,8 @@ def print_shading(view: View, printer) -> dict:
         for light, direction in zip(SHADING.lights, light_directions(view), strict=True)
     ]
     return {
-        "front": vec(SHADING.front),
-        "back": vec(SHADING.back),
+        "front": vec(shading.front),
+        "back": vec(shading.back),
         "background": vec(SHADING.background),
         "ambient": f(SHADING.ambient),
         "specular": f(SHADING.specular),

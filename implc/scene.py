@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -33,6 +33,9 @@ class View:
     fov_y_deg: float = 30.0
     clip_center: Vec3 = (0.0, 0.0, 0.0)
     clip_radius: float = 1.5
+    # front and back colours (RGB in [0, 1]); None: SHADING's (a .jsurf file sets them)
+    front: Vec3 | None = None
+    back: Vec3 | None = None
     # the [view] keys its surface file sets (empty for `-e`): what `apply_view` may
     # choose instead (not part of the view's value)
     given: frozenset[str] = field(default=frozenset(), compare=False, repr=False)
@@ -84,6 +87,13 @@ class Shading:
 
 
 SHADING = Shading()
+
+
+def shading_for(view: View) -> Shading:
+    """SHADING with the view's own front and back colours, where it has them."""
+    if view.front is None and view.back is None:
+        return SHADING
+    return replace(SHADING, front=view.front or SHADING.front, back=view.back or SHADING.back)
 
 
 # --------------------------------------------------------------------------- framing
@@ -199,7 +209,7 @@ def apply_view(
         point = aim + (off_centre + fit_distance(radius, fov, aspect)) * frame_direction(up)
         eye = (float(point[0]), float(point[1]), float(point[2]))
     result = View(eye=eye, target=target, up=up, fov_y_deg=fov, clip_center=center,
-                  clip_radius=radius, given=view.given)
+                  clip_radius=radius, front=view.front, back=view.back, given=view.given)
     if not framed_sphere and not placed_eye:
         return result, None
     return result, Framing(result, framed_sphere, extent, placed_eye, searched)

@@ -61,6 +61,8 @@ class Surface:
     # S with the parameters as symbols (parse.param_symbol), for `--params uniform`;
     # None when the surface has no parameters (then it is `expr`)
     symbolic: sympy.Expr | None = None
+    # what the command line says once about this input (a .jsurf file's ignored keys)
+    notes: tuple[str, ...] = field(default=(), compare=False)
 
     @property
     def equation(self) -> str:
@@ -123,6 +125,10 @@ def load_surface(
         _check_params_used(equation, overrides, params)
         return Surface("equation", expr, values, View(), symbolic=symbolic)
     path = Path(spec)
+    if path.suffix.lower() == ".jsurf":  # SURFER's files (implc/jsurf.py)
+        from .jsurf import load_jsurf
+
+        return load_jsurf(path, overrides, limits, params)
     if not path.suffix and not path.exists():
         examples = example_paths()
         if spec not in examples:

@@ -42,7 +42,7 @@ FSIZE = 64  # bytes: under RLIMIT_FSIZE every output (and temp file) is larger
 SLOW = "sin(" * 34 + "x*y*z" + ")" * 34  # ~2.6 s of CPU in derive + CSE
 
 COMMANDS = ("list", "show", "compile", "validate", "render", "compare", "bench", "corpus",
-            "view")
+            "view", "gallery")
 FAULTS = ("missing input", "unreadable input", "directory input", "directory output",
           "unwritable output", "full disk", "SIGINT", "SIGTERM")
 STDOUT_ONLY = {"list", "show", "validate", "compare"}
@@ -52,6 +52,9 @@ NOT_APPLICABLE = {
     **{("list", f): "list reads no input" for f in
        ("missing input", "unreadable input", "directory input")},
     **{(c, "directory output"): f"{c} writes standard output only" for c in STDOUT_ONLY},
+    **{("gallery", f): "gallery shows a surface's input error in its cell and goes on "
+       "(issue 25; tests/test_jsurf.py)" for f in
+       ("missing input", "unreadable input", "directory input")},
 }
 EXIT = {"SIGINT": 130, "SIGTERM": 143}  # every other fault: 1
 
@@ -96,12 +99,12 @@ def good_input(cmd: str, place: Path) -> str:
                 "view": inputs / "surface.toml",
                 "render": inputs / "surface.toml", "bench": inputs / "surface.toml",
                 "validate": inputs / "shader.frag", "compare": inputs / "render.exr",
-                "corpus": inputs / "corpus.tsv"}.get(cmd, ""))
+                "corpus": inputs / "corpus.tsv", "gallery": inputs / "surface.toml"}.get(cmd, ""))
 
 
 def output_name(cmd: str) -> str:
     return {"compile": "out.frag", "render": "out.png", "bench": "bench-out", "view": "out.html",
-            "corpus": "report.md"}.get(cmd, "")
+            "corpus": "report.md", "gallery": "gallery-out"}.get(cmd, "")
 
 
 def argv(cmd: str, inp: str, out: str, place: Path) -> list[str]:
@@ -117,6 +120,7 @@ def argv(cmd: str, inp: str, out: str, place: Path) -> list[str]:
         "bench": ["bench", inp, "--size", "16", "--frames", "1", "--methods", "taylor",
                   "--configs", "paper", "-o", out],
         "corpus": ["corpus", inp, "--rows", "1-3", "-j", "1", "--no-validate", "-o", out],
+        "gallery": ["gallery", inp, "--size", "16", "-o", out],
     }[cmd]
 
 
@@ -170,7 +174,7 @@ def check_one_line(proc_stderr: str, code: int, expected_code: int, needle: str)
 
 
 def needs_tools(cmd: str) -> None:
-    if cmd in ("render", "bench"):
+    if cmd in ("render", "bench", "gallery"):
         require_gl()
     if cmd == "validate":
         require_tool("glslangValidator")
@@ -209,7 +213,7 @@ def test_fault(cmd, fault, place):
                         folder.with_suffix(".json"))
         inp, needle = str(folder), "directory"
     elif fault == "directory output":
-        if cmd == "bench":  # bench writes a directory: a file in its place is the fault
+        if cmd in ("bench", "gallery"):  # a directory: a file in its place is the fault
             Path(out).write_text("not a directory\n")
             needle = "is a file, not a directory"
         else:
@@ -247,7 +251,7 @@ def test_fault(cmd, fault, place):
     if fault == "directory output":
         expected = {output_name(cmd)}
     assert set(leftovers(out_dir)) == expected, leftovers(out_dir)
-    if fault == "directory output" and cmd != "bench":
+    if fault == "directory output" and cmd not in ("bench", "gallery"):
         assert leftovers(Path(out)) == []
 
 
@@ -316,6 +320,8 @@ def signal_case(cmd: str, fault: str, place: Path) -> None:
                 "hessian", "--configs", "paper", "-o", out]
     elif cmd == "corpus":
         args = ["corpus", inp, "-j", "2", "-t", "glsl", "-o", out]
+    elif cmd == "gallery":
+        args = ["gallery", *[inp] * 40, "--size", "512", "-o", out]
     read = write = None
     stdout = subprocess.PIPE
     if cmd in STDOUT_ONLY:
@@ -334,6 +340,8 @@ def signal_case(cmd: str, fault: str, place: Path) -> None:
         "bench": lambda: any(p.name.startswith(".bench-out.partial-")
                              for p in out_dir.iterdir()) and cpu_seconds(proc.pid) > 1.0,
         "corpus": lambda: len(children(proc.pid)) >= 2,
+        "gallery": lambda: any(p.name.startswith(".gallery-out.partial-")
+                               for p in out_dir.iterdir()) and cpu_seconds(proc.pid) > 1.0,
     }.get(cmd, lambda: blocked_writing(proc.pid))
     deadline = time.monotonic() + 90
     while proc.poll() is None and time.monotonic() < deadline:
@@ -372,4 +380,4 @@ def test_matrix_is_complete():
     sub = next(a for a in parser._actions if a.dest == "command")
     assert set(sub.choices) == set(COMMANDS)
     applicable = [case for case in CASES if case not in NOT_APPLICABLE]
-    assert len(applicable) == len(CASES) - len(NOT_APPLICABLE) == 65
+    assert len(applicable) == len(CASES) - len(NOT_APPLICABLE) == 70

@@ -51,7 +51,7 @@ from sympy.polys.rings import ring
 from .. import interval
 from ..errors import InputError
 from ..numeric import evaluate, evaluate_program
-from ..scene import View, clip_sphere, pixel_rays, shade
+from ..scene import View, clip_sphere, pixel_rays, shade, shading_for
 from ..symbols import DIRECTION, POINT, T, X, Y, Z
 from .result import RenderResult
 
@@ -139,7 +139,8 @@ def render_reference(
     residual[hit] = np.abs(_on(expr, env, hit.sum()))
 
     shape = (height, width)
-    color = shade(grad.reshape(*shape, 3), dirs.reshape(*shape, 3), hit.reshape(shape), view)
+    color = shade(grad.reshape(*shape, 3), dirs.reshape(*shape, 3), hit.reshape(shape), view,
+                  shading_for(view))
     return RenderResult(
         color=color.astype(np.float32),
         hit=hit.reshape(shape),
