@@ -14,7 +14,7 @@ from __future__ import annotations
 import sympy
 from sympy.printing.precedence import PRECEDENCE, precedence
 
-from ..errors import ImplcError
+from ..errors import ImplcError, InputError
 from ..functions import BY_SYMPY_NAME
 
 # Rows of the function table printed by a rule of the mixin, not spelled by a printer's
@@ -24,6 +24,9 @@ RULES: dict[str, str] = {
                  "may override (OpenCL prints a select)",
     "DiracDelta": "the derivative of sign: 0 almost everywhere, printed as the literal 0",
 }
+
+
+FLOAT32_MAX = 3.4028234663852886e38
 
 
 class ShaderPrinterMixin:
@@ -42,6 +45,12 @@ class ShaderPrinterMixin:
         value = float(value)
         if value != value or value in (float("inf"), float("-inf")):
             raise ImplcError(f"the {self.target} printer cannot print the number {value}")
+        if abs(value) > FLOAT32_MAX and getattr(self, "precision", "float") == "float":
+            # WGSL refuses such a literal, GLSL makes it inf: say so before either
+            raise InputError(f"too large for float32: the constant {value:.6g} (in S or "
+                             f"its derivatives) is beyond "
+                             f"float32's range (about 3.4e38), the precision of this "
+                             f"{self.target} shader: scale the equation down")
         text = repr(value)
         if "e" not in text and "." not in text:
             text += ".0"
