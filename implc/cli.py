@@ -551,7 +551,7 @@ def _method_args(p: argparse.ArgumentParser) -> None:
         f"{AUTO_MAX_DEGREE}, else point); see README \"Evaluation forms\""))
 
 
-# Every field of implc.parse.Limits, as the option its error messages name.
+# Every field of implc.limits.Limits, as the option its error messages name.
 LIMIT_FLAGS = {
     "--max-chars": "longest equation, in characters",
     "--max-depth": "deepest nesting of brackets and operators",

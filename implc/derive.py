@@ -17,7 +17,7 @@ from functools import cached_property, lru_cache
 import sympy
 
 from .errors import LimitError
-from .parse import Limits
+from .limits import Limits
 from .symbols import DIRECTION, POINT
 
 # Resource bound (README "Limits"): the estimated size, in expression-tree nodes, of every
@@ -230,7 +230,7 @@ def polynomial_degree(expr: sympy.Expr) -> int | None:
 
     Cached: one compile asks it for the default method, the evaluation form, the exact
     method's check and the ray coefficients, and it is the costliest question of the
-    four (`Poly` expands S; over the reals, since parse.fold_constants made every constant
+    four (`Poly` expands S; over the reals, since front.build.fold_constants made every constant
     a number)."""
     if not expr.is_polynomial(*POINT):
         return None

@@ -17,10 +17,10 @@ import sympy
 
 from .derive import current_max_derived
 from .errors import InputError
+from .front import param_symbol
 from .marcher import choose_form, lower, point_sets
 from .methods import Constants, Method, get_method
 from .optimize import Program
-from .parse import param_symbol
 from .pieces import build_programs, function_name
 from .resources import data_dir
 from .scene import SHADING, View, light_directions

@@ -214,7 +214,7 @@ def test_numeric_check_catches_a_wrong_derivative(monkeypatch):
 
 def test_numeric_check_skips_kinks_but_checks_smooth_points():
     from implc.errors import Source
-    from implc.parse import parse_equation
+    from implc.front import parse_equation
 
     expr = parse_equation(Source("<t>", "abs(x) + max(y, z^2) + x^(1/3) - 1"))
     verdict = corpus.numeric_check(expr, seed=3)

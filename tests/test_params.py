@@ -24,9 +24,9 @@ from test_cli import implc
 
 from implc.emit import emit, param_uniforms
 from implc.errors import InputError
+from implc.front import param_symbol
 from implc.methods import METHODS
 from implc.metrics import compare
-from implc.parse import param_symbol
 from implc.render.run import open_runner, render
 from implc.surface import example_paths, load_surface
 from implc.symbols import X, Y, Z

@@ -1,4 +1,4 @@
-"""The equation parser: grammar, semantics, limits and robustness (implc/parse.py)."""
+"""The equation parser: grammar, semantics, limits and robustness (implc/front/)."""
 
 from __future__ import annotations
 
@@ -10,11 +10,8 @@ from pathlib import Path
 import pytest
 import sympy
 
-from implc import parse as implc_parse
 from implc.errors import InputError, LimitError, Source
-from implc.functions import USER_FUNCTIONS
-from implc.parse import (
-    FOLD_DIGITS,
+from implc.front import (
     Limits,
     check_param_name,
     fold_constants,
@@ -24,6 +21,8 @@ from implc.parse import (
     parse_equation_with_params,
     parse_number,
 )
+from implc.front.build import FOLD_DIGITS, Builder
+from implc.functions import USER_FUNCTIONS
 from implc.symbols import X, Y, Z
 
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "implicit_surface_corpus.tsv"
@@ -412,7 +411,7 @@ def test_huge_powers_are_refused_before_sympy(text: str, monkeypatch) -> None:
     def no_sympy(self, root):
         raise AssertionError(f"sympy was asked to build {text!r}")
 
-    monkeypatch.setattr(implc_parse._Builder, "build", no_sympy)
+    monkeypatch.setattr(Builder, "build", no_sympy)
     with pytest.raises(LimitError):
         parse(text)
 
