@@ -162,7 +162,7 @@ def emit(
         "form": marcher.form,
         "marcher": marcher,
         "lang": f"{tgt.name}/lang.j2",
-        "T": types,
+        "types": types,
         "lit": {k: printer.float_literal(v) for k, v in literals.items()},
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
