@@ -3,8 +3,9 @@
 The point-evaluation form: every quantity is an expression in the point (x, y, z) and,
 for directional ones, the unit ray direction (dx, dy, dz), so that at p(t) = O + tD
     F(t) = S(p),  F'(t) = grad S(p) . D,  F''(t) = D^T H(p) D.
-A second evaluation form (the ray polynomial's coefficients per pixel, then Horner per
-step) can supply the same named quantities later; methods only name what they need.
+The second evaluation form, the ray polynomial (implc/raypoly.py: its coefficients once per
+ray, from `ray_coefficients` here, then F' and F'' by Estrin's scheme at each step),
+supplies the same named quantities; methods only name what they need.
 """
 
 from __future__ import annotations

@@ -1,10 +1,13 @@
 """Program + Target + Method -> shader text, through jinja2 templates.
 
 Python decides what to compute (derive, optimize, implc/marcher.py's lowering of the
-method) and prints every expression and number; templates hold all shader text and do no
-math: templates/marcher.j2 is the marcher skeleton of every target, spelled by
-templates/<target>/lang.j2, inside the target's program or library frame. Rendering is
-strict: a name a template uses but emit does not give is an error, not an empty string.
+method) and prints every expression and number; templates hold all shader text, and the
+only arithmetic they write is the algorithms' own, fixed for every surface (the march
+loop, Newton-bisection, the exact solver's quadratic formula, Newton and Halley steps and
+Bernstein walk in templates/solver.j2). templates/marcher.j2 is the marcher skeleton of
+every target, spelled by templates/<target>/lang.j2, inside the target's program or
+library frame. Rendering is strict: a name a template uses but emit does not give is an
+error, not an empty string.
 """
 
 from __future__ import annotations

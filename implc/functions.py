@@ -44,7 +44,9 @@ class Function:
     # class name of the node `build` makes (what printers and numpy dispatch on); None for
     # sugar whose `build` makes nodes of other rows
     sympy_name: str | None
-    numpy: Callable[..., np.ndarray]  # float64 CPU semantics, same as the shaders'
+    # float64 CPU semantics, the shaders' except `step` (Heaviside) at exactly 0: 0.5 here
+    # and in the reference (sympy's convention), 1 in the shaders (`step(0, x)`)
+    numpy: Callable[..., np.ndarray]
     note: str
     user: bool = True
     # the interval rule (implc/interval.py), None: -m interval refuses the function
@@ -163,7 +165,10 @@ FUNCTIONS: tuple[Function, ...] = (
     Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch", variadic=True),
     # Only in derivatives: the step of min/max/abs and the (ignored) spike of sign.
     Function("step", 1, sympy.Heaviside, "Heaviside", _heaviside,
-             "derivative of min/max; 1 for x > 0, 0 for x < 0", user=False,
+             "derivative of min/max; 1 for x > 0, 0 for x < 0; at 0, 0.5 on the CPU and 1 "
+             "in shaders, so at a tie a == b a shader's derivative of max(a, b) is a' + b' "
+             "where the CPU's is their mean: the same direction (normals agree), F' twice "
+             "as large (Newton is safeguarded)", user=False,
              interval=lambda lo, hi, let: (sympy.Heaviside(lo), sympy.Heaviside(hi),
                                            sympy.false)),
     Function("delta", 1, sympy.DiracDelta, "DiracDelta", lambda x, *_: np.zeros_like(x),
