@@ -3,7 +3,8 @@
 The layer of each module is read from the README's table, so the statement and the check
 cannot drift apart. Every `import` in implc/ counts, function-local ones included. A
 module may import from a lower layer, or from its own layer inside its own package
-(render/run.py uses render/reference.py); across packages the modules of one layer are
+(render/run.py uses render/reference.py; a package's __init__.py, front/__init__.py, is
+inside its package); across packages the modules of one layer are
 independent (validate.py and render/ never import each other).
 """
 
