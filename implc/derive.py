@@ -18,6 +18,7 @@ from functools import cached_property, lru_cache
 import sympy
 
 from .errors import LimitError
+from .functions import FUNCTIONS, Function
 from .limits import Limits
 from .symbols import DIRECTION, POINT
 
@@ -176,22 +177,35 @@ class Derivatives:
         raise KeyError(f"unknown quantity {name!r}; known: {', '.join(QUANTITIES)}")
 
 
-class _BranchAbs(sympy.Function):
-    """|u| with the derivative sign(u) u' for every u (README: abs by branch)."""
-
+def _branch_class(row: Function) -> type[sympy.Function]:
+    """A stand-in for `row`'s sympy class whose derivative is the row's
+    `branch_derivative` for every argument, itself in stand-ins (so F'' branches too)."""
     def fdiff(self, argindex=1):
-        return _BranchSign(self.args[0])
+        return _to_branches(row.branch_derivative(self.args[0]))
+
+    return type(f"_Branch{row.sympy_name}", (sympy.Function,), {"fdiff": fdiff})
 
 
-class _BranchSign(sympy.Function):
-    """sign(u) with sympy's derivative for real u, 2 delta(u) u' (printed as 0)."""
+# sympy class -> its stand-in, for the rows differentiated by branch (abs, sign)
+_BRANCHES: dict[type, type] = {getattr(sympy, f.sympy_name): _branch_class(f)
+                               for f in FUNCTIONS if f.branch_derivative is not None}
 
-    def fdiff(self, argindex=1):
-        return 2 * sympy.DiracDelta(self.args[0])
+
+def _to_branches(expr: sympy.Expr) -> sympy.Expr:
+    for cls, branch in _BRANCHES.items():
+        expr = expr.replace(cls, branch)
+    return expr
+
+
+def _from_branches(expr: sympy.Expr) -> sympy.Expr:
+    for cls, branch in _BRANCHES.items():
+        expr = expr.replace(branch, cls)
+    return expr
 
 
 def branch_diff(expr: sympy.Expr, var: sympy.Symbol) -> sympy.Expr:
-    """d expr / d var with abs and sign differentiated by branch whatever their argument.
+    """d expr / d var with abs and sign differentiated by branch whatever their argument
+    (the function table's `branch_derivative`).
 
     sympy does so only when it can prove the argument real. It cannot for acos(x),
     log(x) or sqrt(x) (complex outside their domain), and then returns re/im/arg terms
@@ -204,11 +218,9 @@ def branch_diff(expr: sympy.Expr, var: sympy.Symbol) -> sympy.Expr:
     """
     if _is_expanded_rational_polynomial(expr):
         return sympy.Poly(expr, *POINT).diff(var).as_expr()
-    if not expr.has(sympy.Abs, sympy.sign):
+    if not expr.has(*_BRANCHES):
         return sympy.diff(expr, var)
-    branched = expr.replace(sympy.Abs, _BranchAbs).replace(sympy.sign, _BranchSign)
-    derived = sympy.diff(branched, var)
-    return derived.replace(_BranchAbs, sympy.Abs).replace(_BranchSign, sympy.sign)
+    return _from_branches(sympy.diff(_to_branches(expr), var))
 
 
 def _is_expanded_rational_polynomial(expr: sympy.Expr) -> bool:

@@ -5,7 +5,11 @@ from __future__ import annotations
 import sympy
 from sympy.printing.str import StrPrinter
 
-_NAMES = {"Abs": "abs", "Min": "min", "Max": "max"}
+from .functions import FUNCTIONS
+
+# sympy class name -> the name users write, where they differ (Abs -> abs)
+_NAMES = {f.sympy_name: f.name for f in FUNCTIONS
+          if f.user and f.sympy_name and f.sympy_name != f.name}
 
 
 class _EquationPrinter(StrPrinter):

@@ -718,3 +718,17 @@ def test_rewrites_the_parser_folds_give_the_same_tree(text: str, rewritten: str)
     """The same tree, so the same shader text and pixels: no render needed to know it
     (tests/test_metamorphic.py renders the rewrites that reach the shader as other text)."""
     assert parse(text) == parse(rewritten)
+
+
+# The function table's `aliases` (implc/functions.py), read by the parser's hints: the test
+# loops over the rows, not over names written here.
+
+_ALIASES = [(alias, f.name) for f in USER_FUNCTIONS.values() for alias in f.aliases]
+
+
+@pytest.mark.parametrize(("alias", "name"), _ALIASES)
+def test_every_alias_in_the_table_names_its_row(alias: str, name: str) -> None:
+    assert len(_ALIASES) >= 12
+    args = ", ".join(["x"] * USER_FUNCTIONS[name].arity)
+    with pytest.raises(InputError, match=rf"unknown function '{alias}'; did you mean '{name}'\?"):
+        parse(f"{alias}({args}) - y")

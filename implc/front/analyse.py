@@ -30,16 +30,16 @@ from implc.front.tree import (
     children,
     postorder,
 )
-from implc.functions import USER_FUNCTIONS
+from implc.functions import FUNCTIONS, USER_FUNCTIONS
 from implc.limits import Limits
 
 _RADICAL_CAP = 10**12  # root degrees saturate here (see Analyzer.check_radicals)
 
 
-_ROOT_FUNCTIONS = {"sqrt": 2, "cbrt": 3}  # table functions that take a root of their argument
+# table functions that take a root of their argument, and its degree
+_ROOT_FUNCTIONS = {f.name: f.root_degree for f in FUNCTIONS if f.root_degree}
 
 
-GROWING = frozenset({"exp", "sinh", "cosh"})  # |f(a)| is about e^|a|: checked when constant
 
 
 NON_REAL_MESSAGES: tuple[tuple[sympy.Basic, str], ...] = (

@@ -14,7 +14,7 @@ from fractions import Fraction
 import sympy
 
 from implc.errors import InputError, Source
-from implc.front.analyse import GROWING, NON_REAL_MESSAGES, Analyzer, NodeInfo, approximate
+from implc.front.analyse import NON_REAL_MESSAGES, Analyzer, NodeInfo, approximate
 from implc.front.tokens import (
     LOG10_2,
     VARIABLES,
@@ -23,12 +23,13 @@ from implc.front.tokens import (
     too_many_digits,
 )
 from implc.front.tree import Call, Named, Neg, Node, Power, Product, Sum, Var, children, postorder
-from implc.functions import CONSTANTS, USER_FUNCTIONS, Function
+from implc.functions import CONSTANTS, FUNCTIONS, USER_FUNCTIONS, Function
 from implc.limits import Limits
 from implc.symbols import X, Y, Z
 
-# sympy classes that compare all their arguments pairwise when evaluated (see docstring).
-_UNEVALUATED = frozenset({"Min", "Max"})
+# sympy classes that compare all their arguments pairwise when evaluated (the table's
+# `unevaluated`; see the package docstring).
+_UNEVALUATED = frozenset(f.sympy_name for f in FUNCTIONS if f.unevaluated)
 
 
 def param_symbol(name: str) -> sympy.Symbol:
@@ -433,7 +434,7 @@ class Builder:
         args = [built[a] for a in node.args]
         if node.name == "exp":
             self.check_exp_argument(node, args[0])
-        if node.name in GROWING and self.info[node.args[0]].constant:
+        if function.grows and self.info[node.args[0]].constant:
             self.check_magnitude(node, args[0], "constant value")  # exp(k log r) is r^k
         expr = _call_expr(function, args)
         if expr.has(sympy.cot):  # tan(x + 3pi/4) is -cot(x + pi/4) to sympy; no target has cot

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from implc.errors import InputError, LimitError, Source
 from implc.front.tokens import CLOSING, CONSTANT_ALIASES, VARIABLES, Token, literal_value, quote
 from implc.front.tree import Call, Named, Neg, Node, Num, Power, Product, Sum, Var
-from implc.functions import CONSTANTS, USER_FUNCTIONS
+from implc.functions import CONSTANTS, FUNCTIONS, USER_FUNCTIONS
 from implc.limits import Limits
 
 # Binding powers (left, right) of the infix operators; right < left is right-associative.
@@ -33,21 +33,9 @@ _IMPLICIT_BP = (20, 21)  # implicit multiplication binds like `*`
 _PREFIX_BP = 25  # unary sign: tighter than `*`, looser than `^`
 
 
-# Names from other languages, with the hint to give when they are called.
-_FUNCTION_ALIASES: dict[str, str] = {
-    "ln": "log",
-    "arcsin": "asin",
-    "arccos": "acos",
-    "arctan": "atan",
-    "arctan2": "atan2",
-    "sgn": "sign",
-    "fabs": "abs",
-    "fmin": "min",
-    "fmax": "max",
-    "sh": "sinh",
-    "ch": "cosh",
-    "th": "tanh",
-}
+# Names from other languages (the table's `aliases`), with the hint to give when they are
+# called.
+_FUNCTION_ALIASES: dict[str, str] = {alias: f.name for f in FUNCTIONS for alias in f.aliases}
 
 
 _POWER_FUNCTIONS = ("pow", "power", "powf")
