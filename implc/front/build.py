@@ -125,7 +125,7 @@ def build_symbolic(
 
 def _call_expr(function: Function, args: list[sympy.Expr]) -> sympy.Expr:
     """A table function applied to built arguments. min and max are built unevaluated (see
-    the module docstring), and with more than two arguments as a balanced tree of
+    implc/front/__init__.py), and with more than two arguments as a balanced tree of
     two-argument calls, the tree the printers fold them into anyway: sympy differentiates
     an n-ary Max through an evaluated Max of the other arguments, which compares them
     pairwise (max of 8 trigonometric terms: 23 s for the Hessian, 1.1 s as a tree)."""
