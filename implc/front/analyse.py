@@ -35,13 +35,8 @@ from implc.limits import Limits
 
 _RADICAL_CAP = 10**12  # root degrees saturate here (see Analyzer.check_radicals)
 
-
 # table functions that take a root of their argument, and its degree
 _ROOT_FUNCTIONS = {f.name: f.root_degree for f in FUNCTIONS if f.root_degree}
-
-
-
-
 NON_REAL_MESSAGES: tuple[tuple[sympy.Basic, str], ...] = (
     (sympy.nan, "value is undefined"),
     (sympy.zoo, "value is infinite"),

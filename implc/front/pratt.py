@@ -25,25 +25,14 @@ _INFIX_BP: dict[str, tuple[int, int]] = {
     "^": (31, 30),
     "**": (31, 30),
 }
-
-
 _IMPLICIT_BP = (20, 21)  # implicit multiplication binds like `*`
-
-
 _PREFIX_BP = 25  # unary sign: tighter than `*`, looser than `^`
-
 
 # Names from other languages (the table's `aliases`), with the hint to give when they are
 # called.
 _FUNCTION_ALIASES: dict[str, str] = {alias: f.name for f in FUNCTIONS for alias in f.aliases}
-
-
 _POWER_FUNCTIONS = ("pow", "power", "powf")
-
-
 _MAX_NAMES_SHOWN = 5  # unknown names listed in one message
-
-
 _MAX_MARKS = 50  # their uses marked under the echoed line
 
 

@@ -21,34 +21,15 @@ from implc.limits import Limits
 from implc.symbols import X, Y, Z
 
 WHITESPACE = " \t\n\r"
-
-
 _OPERATORS = ("**", "==", "+", "-", "*", "/", "^", "=", "(", ")", "[", "]", ",")
-
-
 _DIGITS = frozenset("0123456789")
-
-
 _NUMBER_RE = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
-
-
 _NUMBER_PARTS_RE = re.compile(r"(\d*)(?:\.(\d*))?(?:[eE]([+-]?\d+))?", re.ASCII)
-
-
 _MALFORMED_NUMBER_RE = re.compile(r"[0-9.]*")
-
-
 _WORD_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-
-
 _IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
-
-
 VARIABLES: dict[str, sympy.Symbol] = {"x": X, "y": Y, "z": Z}
-
-
 CLOSING = {"(": ")", "[": "]"}
-
 
 # Characters people paste from papers and word processors, and what they meant.
 _LOOKALIKES: dict[str, str] = {
@@ -84,8 +65,6 @@ _LOOKALIKES: dict[str, str] = {
 # surf and SURFER write `PI` (corpus: IMAGINARY/surfer-alggeo-gtk). Not `E`: it is a
 # common parameter name. A parameter may not take an alias's name.
 CONSTANT_ALIASES: dict[str, str] = {"PI": "pi"}
-
-
 LOG10_2 = 30103  # log10(2) * 10^5, for exact integer comparisons of digit counts
 
 
