@@ -9,7 +9,7 @@ OUT := out
 # cannot name, e.g. AMD Zen 5: see implc/render/cl_runner.py device()), Chromium for the
 # browser tests (WebGL2 and WebGPU on SwiftShader, driven by Playwright for Python from the
 # test extras).
-APT_PACKAGES := glslang-tools libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
+APT_PACKAGES := glslang-tools spirv-cross libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
   pocl-opencl-icd chromium
 # three.js for the browser tests, pinned in tests/browser/package-lock.json (npm ci).
 NPM_DIR := tests/browser
@@ -59,12 +59,12 @@ view: setup
 test: lint
 	$(PY) -m pytest
 
-# Rewrite every golden shader (GLSL, WGSL, OpenCL) from the current output; review the diff.
+# Rewrite every golden shader (every target of implc/targets.py) from the current output;
+# review the diff.
 # Each new text is validated by its real compiler before it is written (an invalid one is
 # refused), emitted twice (same bytes), and every golden file is validated again after.
 golden: setup
-	$(PY) -m pytest tests/test_golden.py tests/test_wgsl.py tests/test_opencl.py \
-	  -k "golden" --update-golden
+	$(PY) -m pytest tests/test_golden.py --update-golden
 
 # ruff, and node's parser over the viewer's script (templates/view/viewer.js, which
 # viewer.html.j2 includes), so a syntax error there fails here, not in a user's browser.

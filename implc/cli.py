@@ -288,15 +288,16 @@ def build_parser() -> argparse.ArgumentParser:
                         "not gl_ for glsl")
     p.add_argument("-o", "--output", type=Path,
                    help="output file; its extension gives the target when -t is not given "
-                        "(.frag/.glsl glsl, .wgsl, .cl opencl); - or none: standard output")
+                        f"({_extension_list(lambda t: t.compile_extensions)}); - or none: "
+                        "standard output")
     p.add_argument("--validate", action="store_true",
                    help="validate with the language's real compiler before writing")
     p.set_defaults(run=cmd_compile)
 
     p = sub.add_parser("validate", help="check shader files with their real compilers",
                        description="Compile each file with its language's real compiler, "
-                                   "chosen by extension: .frag .vert .comp .glsl "
-                                   "(glslangValidator), .wgsl (naga), .cl (PoCL). Every file "
+                                   "chosen by extension: "
+                                   f"{_extension_list(lambda t: t.extensions)}. Every file "
                                    "is read before any compiler runs; exit 3 if one fails.")
     p.add_argument("files", nargs="+", type=Path, metavar="FILE")
     p.add_argument("--stage", choices=list(dict.fromkeys(
@@ -499,6 +500,11 @@ def _number_arg(text: str, low: float, high: float, what: str) -> float:
         raise argparse.ArgumentTypeError(f"{what} must be between {low:g} and {high:g} "
                                          f"(exclusive), got {text}")
     return value
+
+
+def _extension_list(extensions) -> str:
+    """`.frag/.glsl glsl, .wgsl wgsl, ...`: each target's extensions, for the help."""
+    return ", ".join("/".join(extensions(t)) + " " + t.name for t in TARGETS.values())
 
 
 def _shader_args(p: argparse.ArgumentParser) -> None:
@@ -757,9 +763,9 @@ def cmd_show(args) -> int:
 
 
 def shader_extensions(target: str) -> tuple[str, ...]:
-    """File extensions `compile -o` writes for `target` (what `implc validate` reads back:
-    a fragment shader or library for glsl, not .vert or .comp)."""
-    return tuple(ext for ext in TARGETS[target].extensions if ext not in (".vert", ".comp"))
+    """File extensions `compile -o` writes for `target` (its record's: what `implc
+    validate` reads back as the same emit, a fragment shader or library for glsl)."""
+    return TARGETS[target].compile_extensions
 
 
 def _compile_target(args) -> str:

@@ -13,7 +13,7 @@ error, not an empty string.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import jinja2
 import sympy
@@ -33,7 +33,6 @@ from .targets import flavor_problem, get_target, prefix_problem
 EMITS = ("program", "library")
 PARAM_MODES = ("constant", "uniform")
 PARAM_UNIFORM_PREFIX = "u_param_"  # parameter R is the uniform u_param_R (README)
-WGSL_PARAM_OFFSET = 76  # byte offset of the first parameter field in the WGSL Uniforms
 
 
 @dataclass(frozen=True)
@@ -46,38 +45,34 @@ class ParamUniform:
     uniform: str
     ref: str
     value: float  # the surface's value (the default a host starts from)
-    offset: int | None = None  # WGSL program: byte offset in struct Uniforms
+    offset: int | None = None  # byte offset in the program's uniform struct, if it has one
 
 
 def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program",
                    prefix: str = "") -> list[ParamUniform]:
     """The parameters of `surface` as uniforms of a `--params uniform` shader, sorted by
     name (parameters only inside constant exponents stay constants, see
-    `Surface.uniform_params`)."""
+    `Surface.uniform_params`), laid out as the target's record says (`ParamLayout`)."""
     result = []
-    argument = get_target(target).params_read_as == "argument"
+    layout = get_target(target).param_layout[emit]
     for i, name in enumerate(surface.uniform_params()):
         uniform = PARAM_UNIFORM_PREFIX + name
         if "__" in uniform:
             raise InputError(f"parameter '{name}' cannot be a shader uniform: names with "
                              "'__' are reserved in GLSL (rename it or use --params constant)")
-        value = float(surface.params[name])
-        if argument:  # a field of the Params struct the functions take
-            result.append(ParamUniform(name, uniform, f"params.{uniform}", value))
-        elif target == "wgsl" and emit == "program":
-            result.append(ParamUniform(name, uniform, f"u.{uniform}", value,
-                                       WGSL_PARAM_OFFSET + 4 * i))
-        elif target == "wgsl":
-            result.append(ParamUniform(name, uniform, f"{prefix}params.{uniform}", value))
-        elif emit == "library":
-            result.append(ParamUniform(name, prefix + uniform, prefix + uniform, value))
-        else:
-            result.append(ParamUniform(name, uniform, uniform, value))
+        names = {"uniform": uniform, "prefix": prefix}
+        offset = None if layout.offset is None else layout.offset + 4 * i
+        result.append(ParamUniform(name, layout.uniform.format(**names),
+                                   layout.ref.format(**names), float(surface.params[name]),
+                                   offset))
     return result
 
 
-@lru_cache(maxsize=1)
-def environment() -> jinja2.Environment:
+@cache
+def environment(target: str | None = None) -> jinja2.Environment:
+    """The template environment; for a target, with its printer as the global `printer`,
+    through which templates/<target>/lang.j2 spells select and the table's functions
+    (an imported template sees globals, not the render's context)."""
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(data_dir("templates"))),
         undefined=jinja2.StrictUndefined,
@@ -89,6 +84,8 @@ def environment() -> jinja2.Environment:
     # (abstract type, name) -> (the target's type, name), for function parameters
     env.filters["typed"] = lambda pair, types: (types[pair[0]], pair[1])
     env.filters["typed3"] = lambda field, types: (types[field[0]], *field[1:])
+    if target is not None:
+        env.globals["printer"] = get_target(target).make_printer()
     return env
 
 
@@ -139,7 +136,7 @@ def emit(
     if uniforms and tgt.flavors[flavor].get("shadertoy"):
         raise InputError("the shadertoy flavour has no uniforms of its own: use "
                          "--params constant (the default) with --flavor shadertoy")
-    printer = tgt.printer(precision) if len(tgt.precisions) > 1 else tgt.printer()
+    printer = tgt.make_printer(precision)
     expr, equation = surface.expr, surface.equation
     if uniforms:  # the parameters as symbols named as the shader reads them
         expr = surface.symbolic_expr.xreplace(
@@ -159,7 +156,7 @@ def emit(
                     "value": printer.float_literal(u.value),
                     "field": (types["real"], u.uniform, f"parameter {u.name}")}
                    for u in uniforms],
-        "params_struct_size": -(-(WGSL_PARAM_OFFSET + 4 * len(uniforms)) // 16) * 16,
+        "params_struct_size": _struct_size(tgt.param_layout[emit].offset, len(uniforms)),
         "method": meth.name,
         "method_label": label,
         "form": marcher.form,
@@ -174,8 +171,14 @@ def emit(
         "shading": print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
-    template = environment().get_template(tgt.templates[emit])
+    template = environment(tgt.name).get_template(tgt.templates[emit])
     return template.render(context)
+
+
+def _struct_size(offset: int | None, count: int) -> int:
+    """Bytes of a uniform struct whose `count` parameters start at `offset`, rounded up to
+    16 (a uniform buffer's alignment); 0 when the parameters are not laid out in bytes."""
+    return 0 if offset is None else -(-(offset + 4 * count) // 16) * 16
 
 
 def render_template(name: str, **context) -> str:

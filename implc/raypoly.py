@@ -5,12 +5,13 @@ read them)."""
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from functools import lru_cache
 
 import sympy
 
-from .derive import ray_coefficients
+from .derive import polynomial_degree, ray_coefficients
 from .errors import InputError
 from .optimize import Program, count_ops, optimize
 from .pieces import (
@@ -29,11 +30,101 @@ DERIVATIVE_ORDER = {"S": 0, "dS": 1, "d2S": 2}
 
 @lru_cache(maxsize=32)
 def coefficient_program(expr: sympy.Expr) -> Program:
-    """The ray polynomial's coefficients c_0..c_n from (o, d), jointly CSE'd."""
-    coefficients = ray_coefficients(expr)
-    if coefficients is None:
+    """The ray polynomial's coefficients c_0..c_n from (o, d). An equation written
+    factored keeps its factors: truncated polynomial arithmetic over S's own tree, jointly
+    CSE'd. One written out at length (more than HORNER_ABOVE operations) takes Horner's
+    scheme nested over x, y, z (horner_program), which needs no CSE."""
+    if polynomial_degree(expr) is None:
         raise InputError("the ray-poly form needs a polynomial surface")
-    return optimize(list(coefficients), POINT + DIRECTION)
+    if count_ops(expr) > HORNER_ABOVE:
+        return horner_program(expr)
+    return optimize(list(ray_coefficients(expr)), POINT + DIRECTION)
+
+
+# S's size in operations, as written, above which the ray coefficients come by Horner's
+# scheme. Measured on every polynomial row of the corpus: the 11 rows above it (S of
+# 167-3,250 operations, written expanded) take 0.5x the tree's operations (527 against
+# 1,053 on row 39; row 260 2,258 against 2,240) and the degree-18 knot of row 246 (207
+# monomials) 5,639 against 32,525, in 0.8 s where the tree took 27 s, most of it CSE;
+# below it the two routes' programs differ by less and the frames not at all (Steiner
+# 84 against 67 operations, Clebsch 216 against 109: the same exact frame at 512^2,
+# since ray_of runs once a ray).
+HORNER_ABOVE = 150
+
+
+def horner_program(expr: sympy.Expr) -> Program:
+    """c_0..c_n by Horner's scheme on the expanded polynomial, nested over the variables
+    in the order that costs least: S = sum_i x^i (sum_j y^j (sum_k a_ijk z^k)), each sum
+    a Horner loop on truncated polynomials in s, where a step multiplies by the ray's
+    linear polynomial (x + dx s), about 3 operations a coefficient. Every coefficient of
+    every step is named (q0, q1, ...), so the program needs no CSE. The orders are
+    compared by counting alone (building one order's sympy expressions is the cost)."""
+    poly = sympy.Poly(expr, *POINT)
+    n = int(poly.total_degree())
+    terms = dict(poly.terms())
+
+    def count(parts: list[tuple[object, sympy.Symbol | None]]) -> int:
+        nonlocal ops
+        ops += len(parts) - 1 + sum(1 for _, factor in parts if factor is not None)
+        return 0
+
+    costs = []
+    for order in itertools.permutations(range(3)):
+        ops = 0
+        _horner(terms, order, n, count)
+        costs.append((ops, order))
+    order = min(costs)[1]  # the first of equals: deterministic
+    assignments: list[tuple[sympy.Symbol, sympy.Expr]] = []
+
+    def named(parts: list[tuple[sympy.Expr, sympy.Symbol | None]]) -> sympy.Expr:
+        value = sympy.Add(*(v if factor is None else v * factor for v, factor in parts))
+        if value.is_Atom:
+            return value
+        symbol = sympy.Symbol(f"q{len(assignments)}", real=True)
+        assignments.append((symbol, value))
+        return symbol
+
+    outputs = _horner(terms, order, n, named)
+    outputs += [sympy.S.Zero] * (n + 1 - len(outputs))
+    total = sum(count_ops(v) for _, v in assignments)
+    return Program(POINT + DIRECTION, tuple(assignments), tuple(outputs), total, total)
+
+
+def _horner(terms: dict, order: tuple[int, ...], n: int, combine) -> list:
+    """The ray coefficients of sum a_m v^m (m: exponents in POINT order) by Horner's
+    scheme nested in `order`; `combine(parts)` makes the value sum value*factor (factor
+    None: the value alone) of each coefficient of each step, or counts it."""
+    variables = [POINT[i] for i in order]
+
+    def level(depth: int, prefix: tuple[int, ...]) -> list:
+        """sum, over the monomials whose first exponents are `prefix`, of the rest."""
+        exponents = {_permuted(m, order)[depth] for m in terms
+                     if _permuted(m, order)[:depth] == prefix}
+        o, d = variables[depth], DIRECTION[POINT.index(variables[depth])]
+        q: list = []
+        for e in range(max(exponents), -1, -1):
+            if q:  # q * (o + d s), truncated at degree n
+                q = [combine(([(q[m], o)] if m < len(q) else []) + ([(q[m - 1], d)] if m else []))
+                     for m in range(min(len(q) + 1, n + 1))]
+            if e in exponents:
+                inner = ([terms[_unpermuted(prefix + (e,), order)]] if depth == 2
+                         else level(depth + 1, prefix + (e,)))
+                q = [combine([(v[m], None) for v in (q, inner) if m < len(v)])
+                     for m in range(max(len(q), len(inner)))]
+        return q
+
+    return level(0, ())
+
+
+def _permuted(monomial: tuple[int, ...], order: tuple[int, ...]) -> tuple[int, ...]:
+    return tuple(monomial[i] for i in order)
+
+
+def _unpermuted(exponents: tuple[int, ...], order: tuple[int, ...]) -> tuple[int, ...]:
+    monomial = [0, 0, 0]
+    for e, i in zip(exponents, order, strict=True):
+        monomial[i] = e
+    return tuple(monomial)
 
 
 def ray_name(quantities: tuple[str, ...]) -> str:

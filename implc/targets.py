@@ -40,6 +40,9 @@ class Backend:
     runner: str  # "module:function", the runner factory
     about: str  # one line for `implc render --help`
     precision: str = "float"
+    # "module:function" that opens the backend's runtime (a GL context, a wgpu device, an
+    # OpenCL device) or raises ToolError saying why not: tests skip (or fail under CI) on it
+    probe: str = ""
 
 
 # GLSL flavour -> how the program form is framed (read by templates/glsl/program.glsl.j2)
@@ -52,10 +55,25 @@ GLSL_FLAVORS = {
 
 
 @dataclass(frozen=True)
+class ParamLayout:
+    """How the parameters of a `--params uniform` shader reach one emit form (README
+    "Parameters as uniforms"). `{uniform}` is u_param_<name>, `{prefix}` the --prefix."""
+
+    uniform: str = "{uniform}"  # the name the host sets (a uniform, a struct field)
+    ref: str = "{uniform}"  # how the shader's functions read it
+    # byte offset of the first parameter in the program's uniform struct (4 bytes each),
+    # for a language whose host writes the struct as bytes; None: set by name
+    offset: int | None = None
+
+
+@dataclass(frozen=True)
 class Target:
     name: str
     printer_class: str  # "module:Class", the printer: (precision) when several, else ()
     templates: Mapping[str, str]  # emit form (program, library) -> path under templates/
+    # emit form -> the extension of its file (goldens, `compile -o`); `compile -o` writes
+    # any of them, `implc validate` reads them and `extensions`
+    emit_extensions: Mapping[str, str]
     extensions: tuple[str, ...]  # shader files `implc validate` reads as this language
     validator: str  # "module:function": (text, name) -> validate.Verdict
     backends: Mapping[str, Backend]  # render backend name -> Backend
@@ -68,6 +86,9 @@ class Target:
     # (uniforms, a uniform struct) or "argument" (a Params struct that every function
     # evaluating S takes: OpenCL C has no program-scope variables set at run time)
     params_read_as: str = "global"
+    # emit form -> how `--params uniform` parameters reach it (both forms by default)
+    param_layout: Mapping[str, ParamLayout] = field(
+        default_factory=lambda: {"program": ParamLayout(), "library": ParamLayout()})
     # name prefixes the language reserves (`--prefix gl_` would write an invalid shader)
     reserved_prefixes: tuple[str, ...] = ()
     # the shader stages `implc validate --stage` may choose (a language with one kind of
@@ -75,9 +96,18 @@ class Target:
     stages: tuple[str, ...] = ()
 
     @property
+    def compile_extensions(self) -> tuple[str, ...]:
+        """The extensions `implc compile -o` writes in this language."""
+        return tuple(dict.fromkeys(self.emit_extensions.values()))
+
+    @property
     def printer(self) -> Callable[..., object]:
         """The printer class, imported now (it needs sympy)."""
         return resolve(self.printer_class)
+
+    def make_printer(self, precision: str = "float"):
+        """A printer for `precision` (a printer takes one only when there are several)."""
+        return self.printer(precision) if len(self.precisions) > 1 else self.printer()
 
 
 TARGETS: dict[str, Target] = {target.name: target for target in (
@@ -85,12 +115,17 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         name="glsl",
         printer_class="implc.backends.glsl:GlslPrinter",
         templates={"program": "glsl/program.glsl.j2", "library": "glsl/library.glsl.j2"},
+        emit_extensions={"program": ".frag", "library": ".glsl"},
         extensions=(".frag", ".glsl", ".vert", ".comp"),
         validator="implc.validate:validate_glsl",
         backends={"gl": Backend("implc.render.gl:open_gl_runner",
-                                "GLSL 330 on OpenGL (moderngl, EGL; llvmpipe here)")},
+                                "GLSL 330 on OpenGL (moderngl, EGL; llvmpipe here)",
+                                probe="implc.render.gl:context")},
         flavors=GLSL_FLAVORS,
         default_flavor="330",  # also the program the gl backend runs (render/gl.py)
+        # a library's uniforms are globals of the user's shader: they carry the prefix
+        param_layout={"program": ParamLayout(),
+                      "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
         reserved_prefixes=("gl_",),
         stages=("vert", "frag", "comp", "geom", "tesc", "tese"),
     ),
@@ -98,10 +133,16 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         name="wgsl",
         printer_class="implc.backends.wgsl:WgslPrinter",
         templates={"program": "wgsl/program.wgsl.j2", "library": "wgsl/library.wgsl.j2"},
+        emit_extensions={"program": ".wgsl", "library": ".wgsl"},
         extensions=(".wgsl",),
         validator="implc.validate:validate_wgsl",
         backends={"wgpu": Backend("implc.render.wgpu_runner:open_wgpu_runner",
-                                  "WGSL compute shader on wgpu (Vulkan; lavapipe here)")},
+                                  "WGSL compute shader on wgpu (Vulkan; lavapipe here)",
+                                  probe="implc.devices:wgpu_device")},
+        # the program's parameters are fields of struct Uniforms after the camera (the
+        # host writes it as bytes: render/wgpu_runner.py); a library's, of its Params
+        param_layout={"program": ParamLayout(ref="u.{uniform}", offset=76),
+                      "library": ParamLayout(ref="{prefix}params.{uniform}")},
         vector_types=("f32", "vec2<f32>", "vec3<f32>", "vec4<f32>"),
         int_type="i32",
     ),
@@ -110,20 +151,39 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         printer_class="implc.backends.opencl:OpenclPrinter",
         templates={"program": "opencl/program.opencl.j2",
                    "library": "opencl/library.opencl.j2"},
+        emit_extensions={"program": ".cl", "library": ".cl"},
         extensions=(".cl",),
         validator="implc.validate:validate_opencl",
         backends={
             "cl": Backend("implc.render.cl_runner:open_cl_runner",
-                          "OpenCL C kernel, float (pyopencl; PoCL here)"),
+                          "OpenCL C kernel, float (pyopencl; PoCL here)",
+                          probe="implc.devices:opencl_device"),
             "cl-double": Backend("implc.render.cl_runner:open_cl_double_runner",
                                  "the same in double precision (needs cl_khr_fp64)",
-                                 precision="double"),
+                                 precision="double", probe="implc.devices:opencl_device"),
         },
         # templates/opencl/ spell double/double2/double3 from `precision`; the printer
         # checks the same names (backends/opencl.py PRECISIONS)
         precisions=("float", "double"),
         vector_types=("float", "float2", "float3", "float4"),
         params_read_as="argument",
+        param_layout={"program": ParamLayout(ref="params.{uniform}"),
+                      "library": ParamLayout(ref="params.{uniform}")},
+    ),
+    Target(
+        name="hlsl",
+        printer_class="implc.backends.hlsl:HlslPrinter",
+        templates={"program": "hlsl/program.hlsl.j2", "library": "hlsl/library.hlsl.j2"},
+        emit_extensions={"program": ".hlsl", "library": ".hlsl"},
+        extensions=(".hlsl",),
+        validator="implc.validate:validate_hlsl",
+        backends={"hlsl-spirv": Backend(
+            "implc.render.hlsl_runner:open_hlsl_runner",
+            "HLSL pixel shader through SPIR-V (glslang, spirv-cross) on OpenGL (llvmpipe)",
+            probe="implc.render.hlsl_runner:toolchain")},
+        vector_types=("float", "float2", "float3", "float4"),
+        param_layout={"program": ParamLayout(),
+                      "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
     ),
 )}
 

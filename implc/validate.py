@@ -26,12 +26,8 @@ from pathlib import Path
 
 from .devices import FP64, opencl_build, opencl_device, wgpu_device
 from .errors import InputError, ToolError
-from .targets import TARGETS, resolve, target_of_file
+from .targets import TARGETS, get_target, resolve, target_of_file
 
-# glslangValidator's stages by file extension; any other GLSL file (.frag, .glsl) is a
-# fragment shader unless `--stage` says otherwise or a compound suffix does (`.vert.glsl`)
-GLSL_STAGES = {".vert": "vert", ".frag": "frag", ".comp": "comp", ".geom": "geom",
-               ".tesc": "tesc", ".tese": "tese"}
 PLAIN_GLSL_VERSION = "330"  # for a plain GLSL file without #version
 
 
@@ -67,11 +63,13 @@ def glsl_kind(text: str) -> str:
 
 
 def glsl_stage(name: str) -> str:
-    """The stage of a GLSL file by its extension: `x.vert`, `x.vert.glsl`; else frag."""
+    """The stage of a GLSL file by its extension, named as the target record's stages
+    (`x.vert`, `x.vert.glsl`); any other GLSL file (.frag, .glsl) is a fragment shader
+    unless `--stage` says otherwise."""
     suffixes = Path(name).suffixes
-    if suffixes and suffixes[-1] == ".glsl" and len(suffixes) > 1:
-        return GLSL_STAGES.get(suffixes[-2], "frag")
-    return GLSL_STAGES.get(Path(name).suffix, "frag")
+    suffix = suffixes[-2] if len(suffixes) > 1 and suffixes[-1] == ".glsl" else Path(name).suffix
+    stage = suffix[1:]
+    return stage if stage in get_target("glsl").stages else "frag"
 
 
 def check_source(text: str, name: str) -> None:
@@ -114,6 +112,34 @@ def validate_glsl(text: str, name: str = "shader.frag", stage: str | None = None
     if kind == "plain":
         tool += f", no #version: checked as {PLAIN_GLSL_VERSION}"
     return Verdict(proc.returncode == 0, tool, output)
+
+
+def validate_hlsl(text: str, name: str = "shader.hlsl") -> Verdict:
+    """Validate HLSL with glslangValidator's HLSL front end, compiled to SPIR-V as a pixel
+    shader with entry point main (`-D -S frag -e main -V`). A library emit has no entry
+    point, so templates/hlsl/harness.hlsl.j2 appends one that calls its functions; the
+    user's text comes first, so the tool's line numbers are the user's."""
+    from .emit import render_template  # late: emit imports the whole pipeline
+
+    tool = find_tool("glslangValidator")
+    source = text
+    if not re.search(r"\bmain\s*\(", text):
+        match = re.search(r"\bbool\s+(\w*)intersect\s*\(", text)
+        source = render_template("hlsl/harness.hlsl.j2", body=text,
+                                 prefix=match.group(1) if match else "")
+    with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
+        path = os.path.join(tmp, "shader.hlsl")
+        Path(path).write_text(source, encoding="utf-8")
+        try:
+            proc = subprocess.run([tool, "-D", "-S", "frag", "-e", "main", "-V",
+                                   "-o", os.path.join(tmp, "shader.spv"), path],
+                                  capture_output=True, text=True, timeout=120)
+        except subprocess.TimeoutExpired:
+            raise ToolError("glslangValidator did not finish within 120 s") from None
+    output = (proc.stdout + proc.stderr).replace(path, name).strip()
+    output = "\n".join(line for line in output.splitlines() if line.strip() != name)
+    return Verdict(proc.returncode == 0, "glslangValidator, HLSL to SPIR-V",
+                   _locate(output, name, 0))
 
 
 def _library_prefix(text: str) -> str | None:

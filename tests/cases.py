@@ -1,74 +1,76 @@
-"""The test matrix, in one place: which surfaces, methods and flavours are pinned."""
+"""The test matrix, in one place: which surfaces, methods, flavours and precisions are
+pinned, for every target of the registry (implc/targets.py) alike: a new target gets its
+goldens from this list without editing it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
 
 from implc.methods import METHODS
 from implc.surface import example_paths
+from implc.targets import TARGETS
 
 PAPER = ("cross-cap", "miter", "steiner")
 EXAMPLES = tuple(example_paths())
 METHOD_NAMES = tuple(METHODS)
-GLSL_FLAVORS = ("330", "450", "es300", "shadertoy")
 
 
-def golden_cases() -> list[tuple[str, str, str, str]]:
-    """(example, method, flavor, emit): every example with hessian in every flavour, every
-    method on the paper surfaces, a library emit of each paper surface, and the gyroid
-    with interval (program and library)."""
-    cases = [(ex, "hessian", fl, "program") for ex in EXAMPLES for fl in GLSL_FLAVORS]
-    cases += [(ex, m, "330", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
-    cases += [(ex, m, "330", "library") for ex in PAPER for m in ("hessian", "taylor")]
-    cases += [("cross-cap", "exact", fl, "program") for fl in GLSL_FLAVORS if fl != "330"]
-    cases += [("cross-cap", "exact", "330", "library")]
-    cases += [("gyroid", "interval", "330", "program"), ("gyroid", "interval", "330", "library")]
+@dataclass(frozen=True)
+class GoldenCase:
+    """One golden shader: tests/golden/<target>/<name>."""
+
+    target: str
+    example: str
+    method: str
+    emit: str = "program"
+    flavor: str | None = None  # None: the target's default
+    precision: str = "float"
+    taylor2: str = "paper"
+
+    @property
+    def name(self) -> str:
+        """e.g. cross-cap.hessian.330.frag (a flavour only where a target has several),
+        cross-cap.exact.double.cl, cross-cap.hessian.consistent.wgsl,
+        miter.hessian.library.glsl."""
+        target = TARGETS[self.target]
+        parts = [self.example, self.method]
+        parts += [self.taylor2] if self.taylor2 != "paper" else []
+        parts += [self.precision] if self.precision != "float" else []
+        if len(target.flavors) > 1 and self.emit == "program":
+            parts.append(self.flavor or target.default_flavor)
+        parts += [self.emit] if self.emit != "program" else []
+        return ".".join(parts) + target.emit_extensions[self.emit]
+
+    @property
+    def id(self) -> str:
+        return f"{self.target}/{self.name}"
+
+
+def golden_cases(target: str) -> list[GoldenCase]:
+    """The goldens of one target: every example with hessian in every flavour; every
+    method on the paper surfaces; a library emit of each paper surface with hessian and
+    taylor; the Cross-Cap's exact solver in every other flavour, as a library and in
+    every other precision (and hessian there too); the `--taylor2 consistent` branch of
+    both Hessian methods; the gyroid with interval (program and library)."""
+    t = TARGETS[target]
+    other_flavors = [f for f in t.flavors if f != t.default_flavor]
+    other_precisions = [p for p in t.precisions if p != "float"]
+
+    def case(example: str, method: str, **options) -> GoldenCase:
+        return GoldenCase(target, example, method, **options)
+
+    cases = [case(ex, "hessian") for ex in EXAMPLES]
+    cases += [case(ex, "hessian", flavor=fl) for ex in EXAMPLES for fl in other_flavors]
+    cases += [case(ex, m) for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
+    cases += [case(ex, m, emit="library") for ex in PAPER for m in ("hessian", "taylor")]
+    cases += [case("cross-cap", "exact", flavor=fl) for fl in other_flavors]
+    cases += [case("cross-cap", m, precision=p) for p in other_precisions
+              for m in ("hessian", "exact")]
+    cases += [case("cross-cap", m, taylor2="consistent") for m in ("hessian", "hessian-approx")]
+    cases += [case("cross-cap", "exact", emit="library")]
+    cases += [case("gyroid", "interval", emit=kind) for kind in ("program", "library")]
     return cases
 
 
-def golden_name(example: str, method: str, flavor: str, emit: str) -> str:
-    if emit == "library":
-        return f"{example}.{method}.library.glsl"
-    return f"{example}.{method}.{flavor}.frag"
-
-
-def opencl_golden_cases() -> list[tuple[str, str, str, str]]:
-    """(example, method, precision, emit) of the OpenCL goldens: every example with hessian,
-    every method on the paper surfaces, a library emit of each paper surface, and the
-    double-precision Cross-Cap program."""
-    cases = [(ex, "hessian", "float", "program") for ex in EXAMPLES]
-    cases += [(ex, m, "float", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
-    cases += [(ex, "hessian", "float", "library") for ex in PAPER]
-    cases += [("cross-cap", "hessian", "double", "program")]
-    cases += [("cross-cap", "exact", "float", "library"),
-              ("cross-cap", "exact", "double", "program")]
-    cases += [("gyroid", "interval", "float", kind) for kind in ("program", "library")]
-    return cases
-
-
-def opencl_golden_name(example: str, method: str, precision: str, emit: str) -> str:
-    """e.g. cross-cap.hessian.cl, cross-cap.hessian.double.cl, miter.hessian.library.cl"""
-    parts = [example, method]
-    parts += [precision] if precision != "float" else []
-    parts += [emit] if emit != "program" else []
-    return ".".join(parts) + ".cl"
-
-
-def wgsl_golden_cases() -> list[tuple[str, str, str, str]]:
-    """(example, method, taylor2, emit) of the WGSL goldens: every example with hessian,
-    every method on the paper surfaces, the `--taylor2 consistent` branch of both Hessian
-    methods on the Cross-Cap, and a library emit of each paper surface (hessian) and of
-    the Cross-Cap with taylor."""
-    cases = [(ex, "hessian", "paper", "program") for ex in EXAMPLES]
-    cases += [(ex, m, "paper", "program") for ex in PAPER for m in METHOD_NAMES if m != "hessian"]
-    cases += [("cross-cap", m, "consistent", "program") for m in ("hessian", "hessian-approx")]
-    cases += [(ex, "hessian", "paper", "library") for ex in PAPER]
-    cases += [("cross-cap", "taylor", "paper", "library"),
-              ("cross-cap", "exact", "paper", "library")]
-    cases += [("gyroid", "interval", "paper", kind) for kind in ("program", "library")]
-    return cases
-
-
-def wgsl_golden_name(example: str, method: str, taylor2: str, emit: str) -> str:
-    """e.g. cross-cap.hessian.wgsl, cross-cap.hessian.consistent.wgsl,
-    miter.hessian.library.wgsl"""
-    parts = [example, method]
-    parts += [taylor2] if taylor2 != "paper" else []
-    parts += [emit] if emit != "program" else []
-    return ".".join(parts) + ".wgsl"
+def all_golden_cases() -> list[GoldenCase]:
+    return [c for target in TARGETS for c in golden_cases(target)]

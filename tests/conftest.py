@@ -43,18 +43,32 @@ def require_gl():
         pytest.skip(f"no headless OpenGL: {err}")
 
 
-def require_backend(backend: str) -> None:
-    """The runtime of render backend gl, wgpu or cl (skip without it; fail under CI)."""
-    if backend == "gl":
-        require_gl()
-    elif backend == "wgpu":
-        from test_wgsl import require_wgpu
+def require_backend(backend: str):
+    """The runtime of a render backend, opened by its record's probe (a GL context, a
+    wgpu or OpenCL device); skip without it, but fail under CI=true."""
+    from implc.errors import ToolError
+    from implc.targets import TARGETS, resolve
 
-        require_wgpu()
-    else:
-        from test_opencl import require_opencl
+    record = next(t.backends[backend] for t in TARGETS.values() if backend in t.backends)
+    try:
+        return resolve(record.probe)()
+    except ToolError as err:
+        _require(f"render backend {backend}", str(err))
 
-        require_opencl()
+
+def require_validator(target: str):
+    """`validate(text, name)` with the target's real compiler: a missing tool or device
+    (a ToolError) skips, but fails under CI=true."""
+    from implc.errors import ToolError
+    from implc.validate import validate_text
+
+    def validate(text: str, name: str):
+        try:
+            return validate_text(text, target, name)
+        except ToolError as err:
+            _require(f"the {target} validator", str(err))
+
+    return validate
 
 
 # --- the real browser (tests/test_view.py, tests/test_browser.py) --------------------------

@@ -11,6 +11,8 @@ from pathlib import Path
 import pytest
 from conftest import require_tool
 
+from implc.targets import TARGETS
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -202,9 +204,14 @@ def test_render_output_is_checked_before_rendering(tmp_path, output, message):
     assert list(tmp_path.iterdir()) == []
 
 
+# every extension `compile -o` writes, of every target of the registry, as listed
+_EXTENSIONS = [ext for t in TARGETS.values() for ext in t.compile_extensions]
+EVERY_EXTENSION = ", ".join(_EXTENSIONS[:-1]) + " or " + _EXTENSIONS[-1]
+
+
 @pytest.mark.parametrize(("argv", "message"), [
     (["compile", "sphere", "-o", "OUT/s.txt"],
-     "cannot write OUT/s.txt: a shader needs .frag, .glsl, .wgsl or .cl, not '.txt'"),
+     f"cannot write OUT/s.txt: a shader needs {EVERY_EXTENSION}, not '.txt'"),
     (["compile", "sphere", "-t", "glsl", "-o", "OUT/s.txt"],
      "cannot write OUT/s.txt: a glsl shader needs .frag or .glsl, not '.txt'"),
     (["compile", "sphere", "-o", "OUT"],

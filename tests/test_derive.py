@@ -234,3 +234,36 @@ def test_branch_derivative_column_drives_branch_diff(row):
     assert first == row.branch_derivative(inner) * sympy.diff(inner, x)
     second = branch_diff(first, x)
     assert not second.has(sympy.re, sympy.im, sympy.Derivative), second
+
+
+# An expanded degree-9 polynomial, longer than HORNER_ABOVE as written (corpus row 163's
+# shape: many monomials in all three variables), and the bundled examples.
+_EXPANDED = ("x^9 - 3x^7y^2 + 5x^5y^2z^2 - 7x^3y^4z + 2x y^8 - 4y^6z^3 + 6z^9 - 8x^2y^2z^5"
+             " + 9x^4z^4 - y^3z^3 + 2x^6y z - 3x y z^7 + 5y^5 - 2z^4x + x^2 - y + 0.5"
+             " + 4x^3y^3z^3 - 6x^5y^4 + 7y^2z^7 - 5x^7z^2 + 3x^2y^6z - 9x^4y z^4 + 2y^7z^2")
+
+
+@pytest.mark.parametrize("example", ["cross-cap", "steiner", "clebsch", "barth-decic",
+                                     "expanded"])
+def test_both_routes_to_the_ray_coefficients_agree(example):
+    """Horner's nested scheme (raypoly.horner_program) and the tree's truncated
+    arithmetic (derive.ray_coefficients) give the same c_0..c_n at random (o, d); an
+    equation written out at length takes Horner's route."""
+    from implc.derive import ray_coefficients
+    from implc.optimize import count_ops
+    from implc.raypoly import HORNER_ABOVE, coefficient_program, horner_program
+
+    if example == "expanded":
+        expr = load_surface(equation=_EXPANDED).expr
+        assert count_ops(expr) > HORNER_ABOVE
+        assert coefficient_program(expr) == horner_program(expr)
+        p, d = _points("cross-cap")
+    else:
+        expr = load_surface(example).expr
+        p, d = _points(example)
+    program = horner_program(expr)
+    got = evaluate_program(program.assignments, program.outputs, _env(p, d))
+    want = [evaluate(c, _env(p, d)) for c in ray_coefficients(expr)]
+    for k, (g, w) in enumerate(zip(got, want, strict=True)):
+        np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * np.max(np.abs(w)),
+                                   err_msg=f"{example}: c{k}")

@@ -1,47 +1,51 @@
-"""Golden shaders: byte-identical output for every pinned case, each accepted by
-glslangValidator. Update on purpose with `pytest --update-golden` (or `make golden`)."""
+"""Golden shaders of every target in the registry: byte-identical output for every pinned
+case (tests/cases.py), each accepted by its language's real compiler. Update on purpose
+with `pytest tests/test_golden.py --update-golden` (or `make golden`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import pytest
-from cases import golden_cases, golden_name
-from conftest import check_golden, require_tool
+from cases import all_golden_cases
+from conftest import check_golden, require_validator
 
 from implc.emit import emit
+from implc.methods import METHODS
 from implc.surface import load_surface
-from implc.validate import validate_glsl
+from implc.targets import TARGETS
 
-GOLDEN = Path(__file__).parent / "golden" / "glsl"
-
-
-def _emit(example: str, method: str, flavor: str, kind: str) -> str:
-    prefix = example.replace("-", "_") + "_" if kind == "library" else ""
-    return emit(load_surface(example), "glsl", method, None, flavor, kind, prefix)
+GOLDEN = Path(__file__).parent / "golden"
+CASES = all_golden_cases()
+UPDATE = "pytest tests/test_golden.py --update-golden` (or `make golden"
 
 
-@pytest.mark.parametrize("case", golden_cases(), ids=lambda c: golden_name(*c))
+def _emit(case) -> str:
+    prefix = case.example.replace("-", "_") + "_" if case.emit == "library" else ""
+    constants = METHODS[case.method].constants(taylor2=case.taylor2)
+    return emit(load_surface(case.example), case.target, case.method, constants, case.flavor,
+                case.emit, prefix, case.precision)
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.id)
 def test_golden(case, update_golden):
-    name = golden_name(*case)
-    if update_golden:
-        require_tool("glslangValidator")
-    check_golden(GOLDEN / name, lambda: _emit(*case), lambda text: validate_glsl(text, name),
-                 update_golden, "pytest --update-golden` (or `make golden")
+    validate = require_validator(case.target) if update_golden else None
+    check_golden(GOLDEN / case.target / case.name, lambda: _emit(case),
+                 lambda text: validate(text, case.name), update_golden, UPDATE)
 
 
-@pytest.mark.parametrize("case", golden_cases(), ids=lambda c: golden_name(*c))
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.id)
 def test_golden_validates(case):
-    require_tool("glslangValidator")
-    name = golden_name(*case)
-    path = GOLDEN / name
+    validate = require_validator(case.target)
+    path = GOLDEN / case.target / case.name
     if not path.exists():
-        pytest.fail(f"missing golden {path}: run `pytest --update-golden`")
-    verdict = validate_glsl(path.read_text(encoding="utf-8"), name)
-    assert verdict.ok, verdict.render(name)
+        pytest.fail(f"missing golden {path}: run `{UPDATE}`")
+    verdict = validate(path.read_text(encoding="utf-8"), case.name)
+    assert verdict.ok, verdict.render(case.name)
 
 
-def test_no_stale_goldens():
-    expected = {golden_name(*c) for c in golden_cases()}
-    present = {p.name for p in GOLDEN.glob("*")}
+@pytest.mark.parametrize("target", list(TARGETS))
+def test_no_stale_goldens(target):
+    expected = {c.name for c in CASES if c.target == target}
+    present = {p.name for p in (GOLDEN / target).glob("*")}
     assert present <= expected, f"golden files no test produces: {sorted(present - expected)}"

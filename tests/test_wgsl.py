@@ -1,8 +1,5 @@
-"""The WGSL target: golden shaders (byte-compared, each accepted by naga), the printer's
-WGSL rules, the validator's messages, and renders on wgpu that agree with the GL ones.
-
-Update the goldens on purpose with `pytest --update-golden` (or `make golden`).
-"""
+"""The WGSL target: the printer's WGSL rules, the validator's messages, and renders on
+wgpu that agree with the GL ones (its goldens: tests/test_golden.py)."""
 
 from __future__ import annotations
 
@@ -13,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy
-from cases import PAPER, wgsl_golden_cases, wgsl_golden_name
-from conftest import IN_CI, check_golden, require_gl
+from cases import PAPER
+from conftest import IN_CI, require_gl
 from test_cli import implc
 
 from implc.backends.wgsl import RESERVED_WORDS, WgslPrinter
@@ -27,8 +24,7 @@ from implc.surface import load_surface
 from implc.symbols import X
 
 ROOT = Path(__file__).resolve().parent.parent
-GOLDEN = Path(__file__).parent / "golden" / "wgsl"
-CASES = wgsl_golden_cases()
+GOLDEN = Path(__file__).parent / "golden" / "wgsl"  # tests/test_golden.py pins them
 
 
 def require_wgpu():
@@ -55,31 +51,6 @@ def _emit(example: str, method: str, taylor2: str, kind: str) -> str:
     prefix = example.replace("-", "_") + "_" if kind == "library" else ""
     constants = METHODS[method].constants(taylor2=taylor2)
     return emit(load_surface(example), "wgsl", method, constants, None, kind, prefix)
-
-
-# --- goldens -----------------------------------------------------------------------------
-
-@pytest.mark.parametrize("case", CASES, ids=lambda c: wgsl_golden_name(*c))
-def test_golden(case, update_golden):
-    name = wgsl_golden_name(*case)
-    check_golden(GOLDEN / name, lambda: _emit(*case), lambda text: validate(text, name),
-                 update_golden, "pytest --update-golden` (or `make golden")
-
-
-@pytest.mark.parametrize("case", CASES, ids=lambda c: wgsl_golden_name(*c))
-def test_golden_validates(case):
-    name = wgsl_golden_name(*case)
-    path = GOLDEN / name
-    if not path.exists():
-        pytest.fail(f"missing golden {path}: run `pytest --update-golden`")
-    verdict = validate(path.read_text(encoding="utf-8"), name)
-    assert verdict.ok, verdict.render(name)
-
-
-def test_no_stale_goldens():
-    expected = {wgsl_golden_name(*c) for c in CASES}
-    present = {p.name for p in GOLDEN.glob("*")}
-    assert present <= expected, f"golden files no test produces: {sorted(present - expected)}"
 
 
 # --- WGSL rules ---------------------------------------------------------------------------

@@ -149,6 +149,11 @@ class ShaderPrinterMixin:
             text = self.print_select(self._print(cond), self._print(value), text)
         return text
 
+    def print_call(self, function: str, *args: str) -> str:
+        """A call of a table function (its sympy name: `Abs`) on printed arguments, as
+        this target spells it: what templates/<target>/lang.j2 writes for `abs`."""
+        return f"{self.known_functions[function]}({', '.join(args)})"
+
     def print_select(self, cond: str, if_true: str, if_false: str) -> str:
         """cond ? a : b (C family: only the chosen side is evaluated)."""
         return f"({cond} ? {if_true} : {if_false})"
