@@ -48,13 +48,13 @@ class ParamUniform:
     offset: int | None = None  # byte offset in the program's uniform struct, if it has one
 
 
-def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program",
+def param_uniforms(surface: Surface, target: str = "glsl", emit_form: str = "program",
                    prefix: str = "") -> list[ParamUniform]:
     """The parameters of `surface` as uniforms of a `--params uniform` shader, sorted by
     name (parameters only inside constant exponents stay constants, see
     `Surface.uniform_params`), laid out as the target's record says (`ParamLayout`)."""
     result = []
-    layout = get_target(target).param_layout[emit]
+    layout = get_target(target).param_layout[emit_form]
     for i, name in enumerate(surface.uniform_params()):
         uniform = PARAM_UNIFORM_PREFIX + name
         if "__" in uniform:
@@ -108,7 +108,7 @@ def emit(
     method: str = "hessian",
     constants: Constants | None = None,
     flavor: str | None = None,
-    emit: str = "program",
+    emit_form: str = "program",
     prefix: str = "",
     precision: str | None = None,
     evaluation: str | None = None,
@@ -125,14 +125,14 @@ def emit(
     problem = flavor_problem(tgt, flavor) or prefix_problem(prefix, tgt)
     if problem:
         raise InputError(problem)
-    if emit not in EMITS:
-        raise InputError(f"unknown emit '{emit}'; choose from {', '.join(EMITS)}")
+    if emit_form not in EMITS:
+        raise InputError(f"unknown emit '{emit_form}'; choose from {', '.join(EMITS)}")
     precision = precision or "float"
     if precision not in tgt.precisions:
         raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
     if params not in PARAM_MODES:
         raise InputError(f"unknown --params '{params}'; choose from {', '.join(PARAM_MODES)}")
-    uniforms = param_uniforms(surface, target, emit, prefix) if params == "uniform" else []
+    uniforms = param_uniforms(surface, target, emit_form, prefix) if params == "uniform" else []
     if uniforms and tgt.flavors[flavor].get("shadertoy"):
         raise InputError("the shadertoy flavour has no uniforms of its own: use "
                          "--params constant (the default) with --flavor shadertoy")
@@ -156,7 +156,7 @@ def emit(
                     "value": printer.float_literal(u.value),
                     "field": (types["real"], u.uniform, f"parameter {u.name}")}
                    for u in uniforms],
-        "params_struct_size": _struct_size(tgt.param_layout[emit].offset, len(uniforms)),
+        "params_struct_size": _struct_size(tgt.param_layout[emit_form].offset, len(uniforms)),
         "method": meth.name,
         "method_label": label,
         "form": marcher.form,
@@ -171,7 +171,7 @@ def emit(
         "shading": print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
-    template = environment(tgt.name).get_template(tgt.templates[emit])
+    template = environment(tgt.name).get_template(tgt.templates[emit_form])
     return template.render(context)
 
 
