@@ -56,8 +56,7 @@ view: setup
 	$(PY) -m implc view $(VIEW_SURFACE) -o $(OUT)/$(VIEW_SURFACE).html
 	@echo "view: open file://$(CURDIR)/$(OUT)/$(VIEW_SURFACE).html in a browser (drag to turn, sliders move the parameters)"
 
-test: setup
-	$(PY) -m ruff check implc tests
+test: lint
 	$(PY) -m pytest
 
 # Rewrite every golden shader (every target of implc/targets.py) from the current output;
@@ -67,8 +66,12 @@ test: setup
 golden: setup
 	$(PY) -m pytest tests/test_golden.py --update-golden
 
+# ruff, and node's parser over the viewer's script (templates/view/viewer.js, which
+# viewer.html.j2 includes), so a syntax error there fails here, not in a user's browser.
+JS_SOURCES := $(sort $(wildcard templates/*/*.js))
 lint: setup
 	$(PY) -m ruff check implc tests
+	@for f in $(JS_SOURCES); do node --check $$f || exit 1; done
 
 # The paper's Table 1 into results/ (docs/RESULTS.md). 1024x1024 like the paper: on this
 # 2-core llvmpipe machine the costliest cell (curvature at b = 0.002) takes ~1.3 s a

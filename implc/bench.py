@@ -27,7 +27,6 @@ renders/<surface>-reference.png.
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 import statistics
@@ -38,11 +37,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
 
-from . import __version__
+from .bench_report import write_outputs
 from .errors import InputError
-from .fileio import staged_directory, write_atomic, write_with
+from .fileio import staged_directory
 from .methods import METHODS
-from .metrics import T_TOL, compare
+from .metrics import compare
 from .progress import Progress
 from .render.result import RenderResult
 from .render.run import BACKENDS, metadata, open_runner
@@ -55,17 +54,6 @@ DEFAULT_METHODS: tuple[str, ...] = ("taylor", "curvature", "hessian-approx", "he
 CONFIG_NAMES: tuple[str, ...] = ("paper", "equal", "taylor2", "extremum")
 EQUAL_STEP = 0.002  # the paper's hessian step, given to every method in `equal`
 TILE = 256  # figure tile size in pixels
-
-# The paper's Table 1 (NVidia Quadro P5000, 1024x1024): fps and SSIM as printed. The
-# Hessian-exact column has no SSIM: it is the paper's own ground truth (at a tiny step).
-PAPER_TABLE1: dict[str, dict[str, tuple[float, float | None]]] = {
-    "cross-cap": {"taylor": (592, 0.9628), "curvature": (150, 0.9964),
-                  "hessian-approx": (152, 0.9991), "hessian": (23, None)},
-    "miter": {"taylor": (580, 0.9574), "curvature": (154, 0.9957),
-              "hessian-approx": (158, 0.9991), "hessian": (24, None)},
-    "steiner": {"taylor": (416, 0.9214), "curvature": (151, 0.9667),
-                "hessian-approx": (88, 0.9878), "hessian": (25, None)},
-}
 
 
 @dataclass(frozen=True)
@@ -134,7 +122,7 @@ class Cell:
 
 @dataclass
 class BenchRun:
-    """Everything measured; `as_json()` is table.json."""
+    """Everything measured (bench_report.table_json(run) is table.json)."""
 
     size: int
     frames: int
@@ -152,44 +140,6 @@ class BenchRun:
 
     def config_methods(self, config: BenchConfig) -> list[str]:
         return config.applies_to(self.methods)
-
-    def as_json(self) -> dict:
-        return {
-            "implc": __version__,
-            "machine": self.machine,
-            "backend": self.backend,
-            "size": self.size,
-            "frames": self.frames,
-            "warmup_frames": 1,
-            "t_tol": T_TOL,
-            "methods": self.methods,
-            "surfaces": {
-                key: {"name": s.name, "equation": s.equation,
-                      "camera": s.view.camera_json(self.size, self.size),
-                      "clip": s.view.clip_json(),
-                      "reference_seconds": self.reference_seconds.get(key)}
-                for key, s in self.surfaces.items()
-            },
-            "configs": [
-                {
-                    "name": c.name,
-                    "title": c.title,
-                    "constants": {m: METHODS[m].constants(**c.overrides).as_dict()
-                                  for m in self.config_methods(c)},
-                    "results": {
-                        key: {m: self.cells[c.name, key, m].as_json()
-                              for m in self.config_methods(c) if (c.name, key, m) in self.cells}
-                        for key in self.surfaces
-                    },
-                }
-                for c in self.configs
-            ],
-            "baseline": [{"config": c, "surface": k, "method": m, **cell.as_json(),
-                          "generated_fps": self.cells[c, k, m].fps}
-                         for (c, k, m), cell in self.baseline_cells.items()],
-            "paper_table1": {k: {m: {"fps": v[0], "ssim": v[1]} for m, v in row.items()}
-                             for k, row in PAPER_TABLE1.items()},
-        }
 
 
 def machine_info(backend: str) -> dict:
@@ -405,149 +355,3 @@ def _printer(stream: TextIO | None):
             print(line, file=stream, flush=True)
 
     return say
-
-
-# ---- outputs ----------------------------------------------------------------------------
-
-
-def write_outputs(run: BenchRun, out_dir: Path) -> list[Path]:
-    """table.md, table.json and the figures, each written atomically."""
-    out_dir = Path(out_dir)
-    paths = [out_dir / "table.md", out_dir / "table.json"]
-    write_atomic(paths[0], format_markdown(run))
-    write_atomic(paths[1], json.dumps(run.as_json(), indent=2) + "\n")
-    for index, config in enumerate(run.configs):
-        path = out_dir / ("figure.png" if index == 0 else f"figure-{config.name}.png")
-        figure = build_figure(run, config)
-        write_with(path, lambda tmp, image=figure: image.save(tmp, format="PNG"))
-        paths.append(path)
-    return paths
-
-
-def build_figure(run: BenchRun, config: BenchConfig):
-    """Rows = surfaces, columns = the configuration's methods + the reference (Fig. 2)."""
-    from .figure import grid_figure
-
-    methods = run.config_methods(config)
-    columns = [*methods, "reference"]
-    tiles, captions = {}, {}
-    for key in run.surfaces:
-        for method in methods:
-            cell = run.cells.get((config.name, key, method))
-            if cell is None:
-                continue
-            tiles[key, method] = run.tiles[config.name, key, method]
-            captions[key, method] = (
-                method, f"SSIM {cell.metrics['ssim']:.4f}",
-                f"false {cell.metrics['false_hits']} missed {cell.metrics['missed_hits']} "
-                f"wrong {cell.metrics['wrong_root']}")
-        tiles[key, "reference"] = run.tiles["reference", key, "reference"]
-        captions[key, "reference"] = ("exact reference", "(float64 roots)", "")
-    title = f"implc bench {config.name}: {config.title}; {run.size}x{run.size}"
-    return grid_figure(list(run.surfaces), columns, tiles, captions, title)
-
-
-def _cell_text(cell: Cell | None) -> str:
-    if cell is None:
-        return "–"
-    m = cell.metrics
-    ratio = "–" if cell.ratio_to_taylor is None else f"{cell.ratio_to_taylor:.2f}"
-    return (f"{cell.fps:.3g} ({ratio}) / {100 * m['ssim']:.2f}% / {m['false_hits']} / "
-            f"{m['missed_hits']} / {m['wrong_root']} / {m['mean_steps']:.1f}")
-
-
-def format_markdown(run: BenchRun) -> str:
-    """One table per configuration (rows = surfaces, columns = methods), then the paper."""
-    machine = run.machine
-    lines = [
-        "# implc bench",
-        "",
-        f"{run.size}x{run.size} pixels, backend `{run.backend}` "
-        f"(GL renderer: {machine.get('gl_renderer', 'n/a')}), CPU: {machine['cpu_model']} "
-        f"({machine['cpu_count']} logical CPUs). Speed: median fps over {run.frames} frame(s) "
-        "after 1 warm-up frame, each a draw waited for (glFinish or queue wait; the outputs "
-        "are read back once, after the timing); the methods of a surface take "
-        "their frames in turns. Load average (1, 5, 15 min) at start "
-        f"{machine.get('load_average_start')}, at end {machine.get('load_average_end')} "
-        "(other work on the machine lowers fps).",
-        "",
-        "Cell: `fps (fps ratio to taylor) / SSIM / false hits / missed hits / wrong-root "
-        f"pixels / mean march steps per pixel`, against the exact CPU reference "
-        f"(wrong root: both hit and |t - t_ref| > {T_TOL:g}).",
-        "",
-        "Exact reference (CPU, float64): "
-        + ", ".join(f"{k} {s:.2f} s" for k, s in run.reference_seconds.items()) + ".",
-        "",
-    ]
-    for config in run.configs:
-        methods = run.config_methods(config)
-        lines += [f"## {config.name}: {config.title}", ""]
-        lines += ["| surface | " + " | ".join(methods) + " |",
-                  "|---|" + "---|" * len(methods)]
-        for key in run.surfaces:
-            cells = [_cell_text(run.cells.get((config.name, key, m))) for m in methods]
-            lines.append(f"| {key} | " + " | ".join(cells) + " |")
-        lines.append("")
-    lines += _baseline_table(run)
-    lines += _paper_comparison(run)
-    return "\n".join(lines)
-
-
-def _baseline_table(run: BenchRun) -> list[str]:
-    """Generated against hand-written (implc/baseline.py), frames taken in turns."""
-    if not run.baseline_cells:
-        return []
-    lines = [
-        "## generated against hand-written",
-        "",
-        "The hand-written GLSL of templates/baseline/ does the same work as the generated "
-        "program (same step rule, test, refinement after the loop, camera, shading and "
-        "outputs); its frames were taken in the same rounds. Ratio: generated fps / "
-        "hand-written fps (1.00 = as fast).",
-        "",
-        "| config | surface | method | step | generated fps | hand-written fps | ratio | "
-        "hand-written false / missed / wrong |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for (config, key, method), hand in run.baseline_cells.items():
-        generated = run.cells[config, key, method]
-        step = METHODS[method].constants(
-            **next(c for c in run.configs if c.name == config).overrides).step
-        m = hand.metrics
-        lines.append(f"| {config} | {key} | {method} | {step:g} | {generated.fps:.3g} | "
-                     f"{hand.fps:.3g} | {generated.fps / hand.fps:.2f} | "
-                     f"{m['false_hits']} / {m['missed_hits']} / {m['wrong_root']} |")
-    lines.append("")
-    return lines
-
-
-def _paper_comparison(run: BenchRun) -> list[str]:
-    """Paper Table 1 beside the `paper` configuration: fps ratio to taylor and SSIM."""
-    if not any(c.name == "paper" for c in run.configs):
-        return []
-    keys = [k for k in run.surfaces if k in PAPER_TABLE1]
-    methods = [m for m in PAPER_TABLE1["cross-cap"] if m in run.methods]
-    if not keys or not methods:
-        return []
-    lines = [
-        "## paper Table 1 beside `paper`",
-        "",
-        "Cell: fps ratio to taylor (SSIM), the paper's and ours. The paper's "
-        "hessian column is its own ground truth, so it has no SSIM.",
-        "",
-        "| surface | " + " | ".join(methods) + " |",
-        "|---|" + "---|" * len(methods),
-    ]
-    for key in keys:
-        row = PAPER_TABLE1[key]
-        cells = []
-        for m in methods:
-            fps, ssim = row[m]
-            paper = f"{fps / row['taylor'][0]:.3f}" + (f" ({100 * ssim:.2f}%)" if ssim else "")
-            cell = run.cells.get(("paper", key, m))
-            ours = "–" if cell is None or cell.ratio_to_taylor is None else (
-                f"{cell.ratio_to_taylor:.3f} ({100 * cell.metrics['ssim']:.2f}%)")
-            cells.append(f"paper {paper}; ours {ours}")
-        lines.append(f"| {key} | " + " | ".join(cells) + " |")
-    lines.append("")
-    return lines

@@ -579,7 +579,7 @@ def _method_args(p: argparse.ArgumentParser) -> None:
         f"{AUTO_MAX_DEGREE}, else point); see README \"Evaluation forms\""))
 
 
-# Every field of implc.parse.Limits, as the option its error messages name.
+# Every field of implc.limits.Limits, as the option its error messages name.
 LIMIT_FLAGS = {
     "--max-chars": "longest equation, in characters",
     "--max-depth": "deepest nesting of brackets and operators",
@@ -1073,7 +1073,7 @@ def cmd_bench(args) -> int:
 
 
 def cmd_corpus(args) -> int:
-    from . import corpus
+    from . import corpus, corpus_report
 
     wanted = _row_numbers(args.rows) if args.rows else None  # a usage error first
     if args.output:
@@ -1112,11 +1112,11 @@ def cmd_corpus(args) -> int:
         bar.close()
     wall = time.perf_counter() - start
     if args.output:
-        report = corpus.render_report(results, os.path.relpath(tsv), args.targets, wall, jobs,
-                                      validate=not args.no_validate)
+        report = corpus_report.render_report(results, os.path.relpath(tsv), args.targets, wall,
+                                             jobs, validate=not args.no_validate)
         write_atomic(args.output, report)
         print(f"wrote {args.output}", file=sys.stderr)
-    print(corpus.summary_line(results, args.targets) + f" ({wall:.0f} s)")
+    print(corpus_report.summary_line(results, args.targets) + f" ({wall:.0f} s)")
     return 3 if any(r.outcome == corpus.FAILED for r in results) else EXIT_OK
 
 

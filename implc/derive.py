@@ -3,8 +3,9 @@
 The point-evaluation form: every quantity is an expression in the point (x, y, z) and,
 for directional ones, the unit ray direction (dx, dy, dz), so that at p(t) = O + tD
     F(t) = S(p),  F'(t) = grad S(p) . D,  F''(t) = D^T H(p) D.
-A second evaluation form (the ray polynomial's coefficients per pixel, then Horner per
-step) can supply the same named quantities later; methods only name what they need.
+The second evaluation form, the ray polynomial (implc/raypoly.py: its coefficients once per
+ray, from `ray_coefficients` here, then F' and F'' by Estrin's scheme at each step),
+supplies the same named quantities; methods only name what they need.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from functools import cached_property, lru_cache
 import sympy
 
 from .errors import LimitError
-from .parse import Limits
+from .functions import FUNCTIONS, Function
+from .limits import Limits
 from .symbols import DIRECTION, POINT
 
 # Resource bound (README "Limits"): the estimated size, in expression-tree nodes, of every
@@ -175,22 +177,35 @@ class Derivatives:
         raise KeyError(f"unknown quantity {name!r}; known: {', '.join(QUANTITIES)}")
 
 
-class _BranchAbs(sympy.Function):
-    """|u| with the derivative sign(u) u' for every u (README: abs by branch)."""
-
+def _branch_class(row: Function) -> type[sympy.Function]:
+    """A stand-in for `row`'s sympy class whose derivative is the row's
+    `branch_derivative` for every argument, itself in stand-ins (so F'' branches too)."""
     def fdiff(self, argindex=1):
-        return _BranchSign(self.args[0])
+        return _to_branches(row.branch_derivative(self.args[0]))
+
+    return type(f"_Branch{row.sympy_name}", (sympy.Function,), {"fdiff": fdiff})
 
 
-class _BranchSign(sympy.Function):
-    """sign(u) with sympy's derivative for real u, 2 delta(u) u' (printed as 0)."""
+# sympy class -> its stand-in, for the rows differentiated by branch (abs, sign)
+_BRANCHES: dict[type, type] = {getattr(sympy, f.sympy_name): _branch_class(f)
+                               for f in FUNCTIONS if f.branch_derivative is not None}
 
-    def fdiff(self, argindex=1):
-        return 2 * sympy.DiracDelta(self.args[0])
+
+def _to_branches(expr: sympy.Expr) -> sympy.Expr:
+    for cls, branch in _BRANCHES.items():
+        expr = expr.replace(cls, branch)
+    return expr
+
+
+def _from_branches(expr: sympy.Expr) -> sympy.Expr:
+    for cls, branch in _BRANCHES.items():
+        expr = expr.replace(branch, cls)
+    return expr
 
 
 def branch_diff(expr: sympy.Expr, var: sympy.Symbol) -> sympy.Expr:
-    """d expr / d var with abs and sign differentiated by branch whatever their argument.
+    """d expr / d var with abs and sign differentiated by branch whatever their argument
+    (the function table's `branch_derivative`).
 
     sympy does so only when it can prove the argument real. It cannot for acos(x),
     log(x) or sqrt(x) (complex outside their domain), and then returns re/im/arg terms
@@ -203,11 +218,9 @@ def branch_diff(expr: sympy.Expr, var: sympy.Symbol) -> sympy.Expr:
     """
     if _is_expanded_rational_polynomial(expr):
         return sympy.Poly(expr, *POINT).diff(var).as_expr()
-    if not expr.has(sympy.Abs, sympy.sign):
+    if not expr.has(*_BRANCHES):
         return sympy.diff(expr, var)
-    branched = expr.replace(sympy.Abs, _BranchAbs).replace(sympy.sign, _BranchSign)
-    derived = sympy.diff(branched, var)
-    return derived.replace(_BranchAbs, sympy.Abs).replace(_BranchSign, sympy.sign)
+    return _from_branches(sympy.diff(_to_branches(expr), var))
 
 
 def _is_expanded_rational_polynomial(expr: sympy.Expr) -> bool:
@@ -230,7 +243,7 @@ def polynomial_degree(expr: sympy.Expr) -> int | None:
 
     Cached: one compile asks it for the default method, the evaluation form, the exact
     method's check and the ray coefficients, and it is the costliest question of the
-    four (`Poly` expands S; over the reals, since parse.fold_constants made every constant
+    four (`Poly` expands S; over the reals, since front.build.fold_constants made every constant
     a number)."""
     if not expr.is_polynomial(*POINT):
         return None

@@ -1,10 +1,13 @@
 """Program + Target + Method -> shader text, through jinja2 templates.
 
 Python decides what to compute (derive, optimize, implc/marcher.py's lowering of the
-method) and prints every expression and number; templates hold all shader text and do no
-math: templates/marcher.j2 is the marcher skeleton of every target, spelled by
-templates/<target>/lang.j2, inside the target's program or library frame. Rendering is
-strict: a name a template uses but emit does not give is an error, not an empty string.
+method) and prints every expression and number; templates hold all shader text, and the
+only arithmetic they write is the algorithms' own, fixed for every surface (the march
+loop, Newton-bisection, the exact solver's quadratic formula, Newton and Halley steps and
+Bernstein walk in templates/solver.j2). templates/marcher.j2 is the marcher skeleton of
+every target, spelled by templates/<target>/lang.j2, inside the target's program or
+library frame. Rendering is strict: a name a template uses but emit does not give is an
+error, not an empty string.
 """
 
 from __future__ import annotations
@@ -17,10 +20,10 @@ import sympy
 
 from .derive import current_max_derived
 from .errors import InputError
+from .front import param_symbol
 from .marcher import choose_form, lower, point_sets
 from .methods import Constants, Method, get_method
 from .optimize import Program
-from .parse import param_symbol
 from .pieces import build_programs, function_name
 from .resources import data_dir
 from .scene import SHADING, View, light_directions, shading_for
@@ -45,13 +48,13 @@ class ParamUniform:
     offset: int | None = None  # byte offset in the program's uniform struct, if it has one
 
 
-def param_uniforms(surface: Surface, target: str = "glsl", emit: str = "program",
+def param_uniforms(surface: Surface, target: str = "glsl", emit_form: str = "program",
                    prefix: str = "") -> list[ParamUniform]:
     """The parameters of `surface` as uniforms of a `--params uniform` shader, sorted by
     name (parameters only inside constant exponents stay constants, see
     `Surface.uniform_params`), laid out as the target's record says (`ParamLayout`)."""
     result = []
-    layout = get_target(target).param_layout[emit]
+    layout = get_target(target).param_layout[emit_form]
     for i, name in enumerate(surface.uniform_params()):
         uniform = PARAM_UNIFORM_PREFIX + name
         if "__" in uniform:
@@ -105,7 +108,7 @@ def emit(
     method: str = "hessian",
     constants: Constants | None = None,
     flavor: str | None = None,
-    emit: str = "program",
+    emit_form: str = "program",
     prefix: str = "",
     precision: str | None = None,
     evaluation: str | None = None,
@@ -122,14 +125,14 @@ def emit(
     problem = flavor_problem(tgt, flavor) or prefix_problem(prefix, tgt)
     if problem:
         raise InputError(problem)
-    if emit not in EMITS:
-        raise InputError(f"unknown emit '{emit}'; choose from {', '.join(EMITS)}")
+    if emit_form not in EMITS:
+        raise InputError(f"unknown emit '{emit_form}'; choose from {', '.join(EMITS)}")
     precision = precision or "float"
     if precision not in tgt.precisions:
         raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
     if params not in PARAM_MODES:
         raise InputError(f"unknown --params '{params}'; choose from {', '.join(PARAM_MODES)}")
-    uniforms = param_uniforms(surface, target, emit, prefix) if params == "uniform" else []
+    uniforms = param_uniforms(surface, target, emit_form, prefix) if params == "uniform" else []
     if uniforms and tgt.flavors[flavor].get("shadertoy"):
         raise InputError("the shadertoy flavour has no uniforms of its own: use "
                          "--params constant (the default) with --flavor shadertoy")
@@ -153,13 +156,13 @@ def emit(
                     "value": printer.float_literal(u.value),
                     "field": (types["real"], u.uniform, f"parameter {u.name}")}
                    for u in uniforms],
-        "params_struct_size": _struct_size(tgt.param_layout[emit].offset, len(uniforms)),
+        "params_struct_size": _struct_size(tgt.param_layout[emit_form].offset, len(uniforms)),
         "method": meth.name,
         "method_label": label,
         "form": marcher.form,
         "marcher": marcher,
         "lang": f"{tgt.name}/lang.j2",
-        "T": types,
+        "types": types,
         "lit": {k: printer.float_literal(v) for k, v in literals.items()},
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
@@ -168,7 +171,7 @@ def emit(
         "shading": print_shading(surface.view, printer),
         "view": _print_view(surface.view, printer),
     }
-    template = environment(tgt.name).get_template(tgt.templates[emit])
+    template = environment(tgt.name).get_template(tgt.templates[emit_form])
     return template.render(context)
 
 

@@ -10,7 +10,9 @@ a new target adds one dict instead of a column to every row.
 
 To add a function: add a row here (user name, arity, sympy constructor, the sympy class
 name it prints from, numpy implementation, a semantics note, its interval rule and the
-shader's error bound that widens it) and its spelling to every printer's
+shader's error bound that widens it, and whichever of the facts below the row has: other
+languages' names for it, a root it takes, growth like e^|x|, a derivative by branch) and
+its spelling to every printer's
 `known_functions`. Rows with `user=False` are never written by users; they appear only in
 derivatives (e.g. d|x|/dx = sign(x)) or in interval rules (floor) and must still print on
 every target. A row without an interval rule makes `-m interval` refuse a surface that
@@ -44,7 +46,9 @@ class Function:
     # class name of the node `build` makes (what printers and numpy dispatch on); None for
     # sugar whose `build` makes nodes of other rows
     sympy_name: str | None
-    numpy: Callable[..., np.ndarray]  # float64 CPU semantics, same as the shaders'
+    # float64 CPU semantics, the shaders' except `step` (Heaviside) at exactly 0: 0.5 here
+    # and in the reference (sympy's convention), 1 in the shaders (`step(0, x)`)
+    numpy: Callable[..., np.ndarray]
     note: str
     user: bool = True
     # the interval rule (implc/interval.py), None: -m interval refuses the function
@@ -54,6 +58,19 @@ class Function:
     error: tuple[float, float] = (0.0, 0.0)
     # takes `arity` or more arguments (min, max: users write CSG as max(a, b, c))
     variadic: bool = False
+    # built unevaluated (min, max): evaluating makes sympy compare every pair of
+    # (flattened) arguments symbolically, minutes for nested calls (implc/front/build.py)
+    unevaluated: bool = False
+    # names other languages give it: an unknown call of one gets `did you mean` this row
+    aliases: tuple[str, ...] = ()
+    # takes the n-th root of its argument (sqrt 2, cbrt 3): the front end bounds the
+    # digits of exact constants under nested roots (implc/front/analyse.py)
+    root_degree: int = 0
+    # |f(a)| is about e^|a|: a constant argument is checked against the magnitude limit
+    grows: bool = False
+    # u -> d f(u)/du by branch, for every u (sympy gives abs and sign a derivative only
+    # where it can prove u real); derive.branch_diff differentiates the row with it
+    branch_derivative: Callable[[sympy.Expr], sympy.Expr] | None = None
 
 
 def _heaviside(x, *_):
@@ -132,38 +149,46 @@ FUNCTIONS: tuple[Function, ...] = (
              interval=_periodic(sympy.cos, 0), error=(8, 2.0**-21)),
     Function("tan", 1, sympy.tan, "tan", np.tan, "radians", interval=_tan, error=(16, 2.0**-21)),
     Function("asin", 1, sympy.asin, "asin", np.arcsin, "domain [-1, 1]",
-             interval=_on_domain(sympy.asin, -1, 1), error=(16, 2.0**-10)),
+             interval=_on_domain(sympy.asin, -1, 1), error=(16, 2.0**-10), aliases=("arcsin",)),
     Function("acos", 1, sympy.acos, "acos", np.arccos, "domain [-1, 1]",
-             interval=_on_domain(sympy.acos, -1, 1, increasing=False), error=(16, 2.0**-11)),
+             interval=_on_domain(sympy.acos, -1, 1, increasing=False), error=(16, 2.0**-11),
+             aliases=("arccos",)),
     Function("atan", 1, sympy.atan, "atan", np.arctan, "range (-pi/2, pi/2)",
-             interval=_increasing(sympy.atan), error=(16, 2.0**-18)),
+             interval=_increasing(sympy.atan), error=(16, 2.0**-18), aliases=("arctan",)),
     # atan2 has no interval rule (its branch cut): -m interval refuses it
-    Function("atan2", 2, sympy.atan2, "atan2", np.arctan2, "atan2(y, x), angle of (x, y)"),
+    Function("atan2", 2, sympy.atan2, "atan2", np.arctan2, "atan2(y, x), angle of (x, y)",
+             aliases=("arctan2",)),
     Function("sinh", 1, sympy.sinh, "sinh", np.sinh, "", interval=_increasing(sympy.sinh),
-             error=(16, 2.0**-21)),
+             error=(16, 2.0**-21), aliases=("sh",), grows=True),
     Function("cosh", 1, sympy.cosh, "cosh", np.cosh, "", interval=_even(sympy.cosh),
-             error=(16, 0)),
+             error=(16, 0), aliases=("ch",), grows=True),
     Function("tanh", 1, sympy.tanh, "tanh", np.tanh, "", interval=_increasing(sympy.tanh),
-             error=(16, 2.0**-21)),
+             error=(16, 2.0**-21), aliases=("th",)),
     Function("exp", 1, sympy.exp, "exp", np.exp, "", interval=_increasing(sympy.exp),
-             error=(16, 0)),
+             error=(16, 0), grows=True),
     Function("log", 1, sympy.log, "log", np.log, "natural logarithm; x > 0", interval=_log,
-             error=(16, 2.0**-21)),
+             error=(16, 2.0**-21), aliases=("ln",)),
     Function("sqrt", 1, sympy.sqrt, "sqrt", np.sqrt, "x >= 0; NaN (no surface) below",
-             interval=_on_domain(sympy.sqrt, 0), error=(4, 0)),
+             interval=_on_domain(sympy.sqrt, 0), error=(4, 0), root_degree=2),
     # Sugar: builds sign(a)*|a|^(1/3) from other rows, so no node of its own reaches a printer.
     Function("cbrt", 1, lambda a: sympy.sign(a) * sympy.Abs(a) ** sympy.Rational(1, 3), None,
-             np.cbrt, "real cube root, defined for negative x (same as x^(1/3))"),
-    Function("abs", 1, sympy.Abs, "Abs", np.abs, "derivative sign(x)", interval=_abs),
+             np.cbrt, "real cube root, defined for negative x (same as x^(1/3))", root_degree=3),
+    Function("abs", 1, sympy.Abs, "Abs", np.abs, "derivative sign(x)", interval=_abs,
+             aliases=("fabs",), branch_derivative=sympy.sign),
     Function("sign", 1, sympy.sign, "sign", np.sign, "-1, 0 or 1; derivative 0",
-             interval=lambda lo, hi, let: (sympy.sign(lo), sympy.sign(hi), sympy.false)),
+             interval=lambda lo, hi, let: (sympy.sign(lo), sympy.sign(hi), sympy.false),
+             aliases=("sgn",), branch_derivative=lambda u: 2 * sympy.DiracDelta(u)),
     # min and max take their arguments' bounds apart (implc/interval.py)
     Function("min", 2, sympy.Min, "Min", np.minimum, "smooth union in CSG; derivative by branch",
-             variadic=True),
-    Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch", variadic=True),
+             variadic=True, unevaluated=True, aliases=("fmin",)),
+    Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch", variadic=True,
+             unevaluated=True, aliases=("fmax",)),
     # Only in derivatives: the step of min/max/abs and the (ignored) spike of sign.
     Function("step", 1, sympy.Heaviside, "Heaviside", _heaviside,
-             "derivative of min/max; 1 for x > 0, 0 for x < 0", user=False,
+             "derivative of min/max; 1 for x > 0, 0 for x < 0; at 0, 0.5 on the CPU and 1 "
+             "in shaders, so at a tie a == b a shader's derivative of max(a, b) is a' + b' "
+             "where the CPU's is their mean: the same direction (normals agree), F' twice "
+             "as large (Newton is safeguarded)", user=False,
              interval=lambda lo, hi, let: (sympy.Heaviside(lo), sympy.Heaviside(hi),
                                            sympy.false)),
     Function("delta", 1, sympy.DiracDelta, "DiracDelta", lambda x, *_: np.zeros_like(x),

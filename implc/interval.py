@@ -214,7 +214,7 @@ class _Builder:
             raise InputError(f"-m interval has no interval rule for the power {node} with "
                              "a variable exponent; use another method (-m hessian)")
         # x^r, r not an integer: defined for x >= 0 (real roots of negative x are written
-        # sign(x)|x|^r, implc/parse.py), increasing for r > 0, decreasing for r < 0
+        # sign(x)|x|^r, implc/front/build.py), increasing for r > 0, decreasing for r < 0
         self.dead.append(b < 0)
         a = self.let(Max(a, 0, evaluate=False), "m")
         b = self.let(Max(b, 0, evaluate=False), "m")

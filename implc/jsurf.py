@@ -42,8 +42,8 @@ from sympy.printing.str import StrPrinter
 
 from .errors import InputError, Source
 from .fileio import read_input
+from .front import check_param_name, parse_equation_with_params, parse_number
 from .limits import Limits
-from .parse import check_param_name, parse_equation_with_params, parse_number
 from .scene import SHADING, View, view_problems
 from .surface import MAX_FILE_BYTES, Surface
 from .symbols import X, Y, Z

@@ -1,5 +1,5 @@
 """The input limits (`Limits`): plain data, without sympy, so that the command line can
-show their defaults in `--help` without loading the parser (implc/parse.py checks them;
+show their defaults in `--help` without loading the parser (implc/front/ checks them;
 each field is a `--max-...` option)."""
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ evaluation form is printed here, by the target's printer:
   for the refinement;
 - `step_size(ray, s, f0)`: the step rule; `root_in(f0, f1, h)`: the root test.
 
-Evaluation forms (DESIGN.md section 2) say how a ray quantity at a ray parameter is
+Evaluation forms (docs/ARCHITECTURE.md) say how a ray quantity at a ray parameter is
 computed; a method never knows which one it gets:
 - `point`: jointly CSE'd functions of p = ray.o + s*ray.d and d: `SDH(p, d)` returns
   (F, F', F'') together;
@@ -54,8 +54,8 @@ from .pieces import (
     COMPONENT,
     QUANTITY_ORDER,
     RETURN_TYPE,
-    Code,
     Marcher,
+    PrintedBody,
     build_programs,
     function_name,
     point_function,
@@ -67,9 +67,10 @@ from .solver import check_exact, lower_solver
 # EVAL_CHOICES and AUTO_MAX_DEGREE (`auto`'s rule) are plain data in implc/options.py
 
 # When the root test's inputs are ready, in operations (optimize.arrange_by_depth): the
-# start sample (F0, F0', X0) first, then the step length h (after the step rule), then the
-# end sample (F1, F1', X1), evaluated at s0 + h.
-_H_DEPTH, _LATE = 10, 1000
+# start sample (F0, F0', X0) first (depth 0), then the step length h, after the step rule,
+# then the end sample (F1, F1', X1), evaluated at s0 + h, after everything else.
+STEP_LENGTH_READY = 10
+END_SAMPLE_READY = 1000
 # What the ray polynomial gives (by Estrin's scheme): F' and F''. F itself, whose sign is the
 # answer, is the ray polynomial's only where that sign is certain: its float32 value, from
 # coefficients rounded once per ray, errs by a smooth offset along the whole ray, which
@@ -191,14 +192,15 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     if method.bounds:  # F's enclosure over a segment works on S's tree, at points
         form = "point"
 
-    def show(expr: sympy.Basic) -> str:
+    def print_expr(expr: sympy.Basic) -> str:
+        """`expr` in the target's language, the method's constants by their shader names."""
         return printer.doprint(expr.xreplace(const_names))
 
     wanted = evaluations(method, form)
     programs = build_programs(expr, point_sets(method, form), max_derived)
     functions = [point_function(name, program, printer, carried)
                  for name, program in programs.items()]
-    fields, ray = (), Code((), ())  # the point form's ray record: o, d and sm only
+    fields, ray = (), PrintedBody((), ())  # the point form's ray record: o, d and sm only
     if form == "ray-poly":
         coefficients = coefficient_program(expr)
         n = len(coefficients.outputs) - 1
@@ -209,9 +211,9 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
 
     def call(kind: str, quantities: tuple[str, ...], arg: sympy.Expr,
              point: str | None = None) -> str:
-        at = f"({show(arg)})" if arg.is_Add else show(arg)
+        at = f"({print_expr(arg)})" if arg.is_Add else print_expr(arg)
         if kind == "ray":
-            return f"{prefix}{ray_name(quantities)}(ray, {show(arg)})"
+            return f"{prefix}{ray_name(quantities)}(ray, {print_expr(arg)})"
         fn = by_name[function_name(quantities)]
         args = [point or f"ray.o + {at}*ray.d", "ray.d"][: len(fn.params) - len(carried)]
         args += from_ray(carried)
@@ -232,14 +234,15 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
         # the march point s = s0 + h as (o + s0 d) + h d: o + s0 d is known a step early,
         # so the point is one operation after h, not two after s (templates/marcher.j2)
         calls(group, arg, "e", lets, replace, _MARCH_POINT if arg == S else None)
-    sample = Code(tuple(lets), tuple(show(e.xreplace(replace)) for e in method.sample))
+    sample = PrintedBody(tuple(lets), tuple(print_expr(e.xreplace(replace)) for e in method.sample))
     lets, replace = [], {}
     calls(REFINE_SET, S, "e", lets, replace)
-    fd = Code(tuple(lets), tuple(show(_apply(q, S).xreplace(replace)) for q in REFINE_SET))
+    fd = PrintedBody(tuple(lets), tuple(print_expr(_apply(q, S).xreplace(replace))
+                                        for q in REFINE_SET))
 
     ends0 = {F0: sym("f0.x"), D0: sym("f0.y"), X0: sym("f0.z")}
     ends1 = {F1: sym("f1.x"), D1: sym("f1.y"), X1: sym("f1.z")}
-    step = Code((), (show(method.step.xreplace(ends0)),))
+    step = PrintedBody((), (print_expr(method.step.xreplace(ends0)),))
 
     rule = method.root_rule(constants.taylor2)
     ends = {**ends0, **ends1}
@@ -249,8 +252,9 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     names = {**ends, **const_names}
     lets, value = arrange_by_depth([(s, v.xreplace(names)) for s, v in rule.lets],
                                    rule.value.xreplace(names),
-                                   {**dict.fromkeys(ends1.values(), _LATE), H: _H_DEPTH})
-    root = Code(tuple(("real", s.name, printer.doprint(v)) for s, v in lets),
+                                   {**dict.fromkeys(ends1.values(), END_SAMPLE_READY),
+                                    H: STEP_LENGTH_READY})
+    root = PrintedBody(tuple(("real", s.name, printer.doprint(v)) for s, v in lets),
                 (printer.doprint(value),), rule.what)
 
     used = set().union(*(e.free_symbols for e in (*method.sample, method.step, rule.value,

@@ -1,6 +1,6 @@
 """The method registry: each marcher of the paper, defined once, as data.
 
-A method is three sympy expressions (DESIGN.md section 4):
+A method is three sympy expressions (docs/ARCHITECTURE.md, "The methods"):
 - `sample`: what it evaluates at a march point s, a triple (F, F', X) built from the ray
   quantities F(s), dF(s), d2F(s) and lap(s) (X is the method's extra value, 0 if none);
 - `step`: the step length at the start of a step, a Piecewise over that end's sample

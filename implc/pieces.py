@@ -44,7 +44,7 @@ class ShaderFunction:
 
 
 @dataclass(frozen=True)
-class Code:
+class PrintedBody:
     """A printed body: `lets` (abstract type, name, value) in order, then `values`."""
 
     lets: tuple[tuple[str, str, str], ...]
@@ -60,11 +60,11 @@ class Marcher:
     functions: tuple[ShaderFunction, ...]
     constants: tuple[tuple[str, str, str], ...]  # (abstract type, name, printed value)
     ray_fields: tuple[tuple[str, str, str], ...]  # beyond o, d, sm: (type, name, comment)
-    ray: Code  # lets of ray_of(ro, rd, sm, hr) after oc = ro + sm rd; the fields' values
-    sample: Code
-    fd: Code
-    step: Code
-    root: Code
+    ray: PrintedBody  # lets of ray_of(ro, rd, sm, hr) after oc = ro + sm rd; the fields' values
+    sample: PrintedBody
+    fd: PrintedBody
+    step: PrintedBody
+    root: PrintedBody
     solver: Solver | None = None
     carried: tuple[tuple[str, str], ...] = ()  # see `lower`
     interval: bool = False  # the interval march (templates/interval.j2)

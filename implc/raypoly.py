@@ -14,7 +14,15 @@ import sympy
 from .derive import polynomial_degree, ray_coefficients
 from .errors import InputError
 from .optimize import Program, count_ops, optimize
-from .pieces import COMPONENT, RETURN_TYPE, Code, ShaderFunction, function_name, printed_lets, sym
+from .pieces import (
+    COMPONENT,
+    RETURN_TYPE,
+    PrintedBody,
+    ShaderFunction,
+    function_name,
+    printed_lets,
+    sym,
+)
 from .symbols import DIRECTION, POINT
 
 DERIVATIVE_ORDER = {"S": 0, "dS": 1, "d2S": 2}
@@ -129,7 +137,7 @@ def ray_name(quantities: tuple[str, ...]) -> str:
     return "ray_" + function_name(quantities)
 
 
-def ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
+def ray_setup(coefficients: Program, printer) -> tuple[tuple, PrintedBody]:
     """The ray record's fields and ray_of's body. The polynomial is expanded about the
     middle of the march interval: the record's origin is o = ro + sm rd and
     F(s) = S(o + s d) = sum c_k s^k, so |s| is at most hr, half the chord): about the
@@ -147,7 +155,7 @@ def ray_setup(coefficients: Program, printer) -> tuple[tuple, Code]:
     lets.append(("real", "size", printer.doprint(size)))
     fields = (("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"),)
     fields += tuple(("real", f"c{k}", f"coefficient of u^{k}") for k in range(n + 1))
-    return fields, Code(tuple(lets), ("size", *(f"c{k}" for k in range(n + 1))))
+    return fields, PrintedBody(tuple(lets), ("size", *(f"c{k}" for k in range(n + 1))))
 
 
 def from_ray(carried: tuple[tuple[str, str], ...]) -> list[str]:
@@ -156,11 +164,11 @@ def from_ray(carried: tuple[tuple[str, str], ...]) -> list[str]:
 
 
 def carry(carried: tuple[tuple[str, str], ...], fields: tuple,
-           ray: Code) -> tuple[tuple, Code]:
+           ray: PrintedBody) -> tuple[tuple, PrintedBody]:
     """The ray record with the carried arguments as fields (ray_of takes them)."""
     fields += tuple((kind, name, "carried for the functions that evaluate S")
                     for kind, name in carried)
-    return fields, Code(ray.lets, ray.values + tuple(name for _, name in carried))
+    return fields, PrintedBody(ray.lets, ray.values + tuple(name for _, name in carried))
 
 
 def horner(coefficients: Sequence[sympy.Expr], x: sympy.Expr) -> sympy.Expr:

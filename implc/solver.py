@@ -14,7 +14,15 @@ from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
 from .options import EXACT_MAX_DEGREE
-from .pieces import Code, Marcher, ShaderFunction, build_programs, point_function, printed_lets, sym
+from .pieces import (
+    Marcher,
+    PrintedBody,
+    ShaderFunction,
+    build_programs,
+    point_function,
+    printed_lets,
+    sym,
+)
 from .raypoly import (
     carry,
     coefficient_program,
@@ -161,7 +169,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     bottom = 2 if n >= 3 else 1
     m = n - bottom
     closed = tuple(printer.doprint(v) for v in derivative_coefficients(n, m))
-    empty = Code((), ())
+    empty = PrintedBody((), ())
     solver = Solver(n, bottom, closed)
     if bernstein:
         # Newton starts at the zero of the root node's control polygon (the points

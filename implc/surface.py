@@ -32,7 +32,7 @@ import sympy
 
 from .errors import InputError, Source
 from .fileio import read_input
-from .parse import (
+from .front import (
     Limits,
     check_param_name,
     parse_constant,
@@ -58,7 +58,7 @@ class Surface:
     params: dict[str, sympy.Expr] = field(default_factory=dict)  # exact values
     view: View = field(default_factory=View)
     origin: str = "<equation>"  # file path, example name or "<equation>"
-    # S with the parameters as symbols (parse.param_symbol), for `--params uniform`;
+    # S with the parameters as symbols (front.param_symbol), for `--params uniform`;
     # None when the surface has no parameters (then it is `expr`)
     symbolic: sympy.Expr | None = None
     # what the command line says once about this input (a .jsurf file's ignored keys)
@@ -238,7 +238,7 @@ def _example_hint(spec: str, examples: Mapping[str, Path]) -> str:
     return f"; did you mean {listed}?"
 
 
-# A number or a word, as the equation's tokenizer reads them (implc/parse.py): `1e3` is a
+# A number or a word, as the equation's tokenizer reads them (implc/front/tokens.py): `1e3` is a
 # number, not the word `e3`; `2R` is 2 and `R`.
 _NUMBER_OR_WORD = re.compile(r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|([A-Za-z_][A-Za-z0-9_]*)",
                              re.ASCII)

@@ -5,7 +5,11 @@ from __future__ import annotations
 import sympy
 from sympy.printing.str import StrPrinter
 
-_NAMES = {"Abs": "abs", "Min": "min", "Max": "max"}
+from .functions import FUNCTIONS
+
+# sympy class name -> the name users write, where they differ (Abs -> abs)
+_NAMES = {f.sympy_name: f.name for f in FUNCTIONS
+          if f.user and f.sympy_name and f.sympy_name != f.name}
 
 
 class _EquationPrinter(StrPrinter):
@@ -17,7 +21,7 @@ class _EquationPrinter(StrPrinter):
 
     def _print_Min(self, expr):
         """min(a, b, c) as written: the parser builds it as min(min(a, b), c)
-        (parse._call_expr); min and max are associative, so flattening prints the same
+        (front.build._call_expr); min and max are associative, so flattening prints the same
         function."""
         args, stack = [], list(reversed(expr.args))
         while stack:
@@ -40,7 +44,7 @@ class _EquationPrinter(StrPrinter):
         return super()._print_Rational(expr)
 
     def _print_Float(self, expr):
-        """A folded constant (parse.fold_constants) as the shortest decimal of its float64
+        """A folded constant (front.build.fold_constants) as the shortest decimal of its float64
         value, the value a shader gets: `sqrt(2)` reads 1.4142135623730951."""
         return repr(float(expr))
 

@@ -183,7 +183,7 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
     surface = load_surface("torus")
     view = surface.view
     prefix = "torus_"
-    library = emit(surface, "glsl", "hessian", hessian(), emit="library", prefix=prefix,
+    library = emit(surface, "glsl", "hessian", hessian(), emit_form="library", prefix=prefix,
                    params="uniform")
     data = {
         "width": THREE_SIZE, "height": THREE_SIZE,

@@ -23,8 +23,9 @@ from pathlib import Path
 import pytest
 from conftest import require_tool
 
-from implc import corpus
-from implc.corpus import COMPILED, REJECTED, TARGETS, figures, load_rows, run_corpus
+from implc import corpus, corpus_report
+from implc.corpus import COMPILED, REJECTED, TARGETS, load_rows, run_corpus
+from implc.corpus_report import figures
 
 DATA = Path(__file__).parent / "data"
 PERMISSIVE_TSV = DATA / "corpus_permissive.tsv"
@@ -164,9 +165,9 @@ def test_whole_corpus_reaches_95_percent_on_every_target(permissive_results, gpl
 
 
 def test_every_rejection_falls_in_a_named_category():
-    categories = {name for _, name in corpus._CATEGORIES}
+    categories = {name for _, name in corpus_report._CATEGORIES}
     for reason in EXPECTED_REJECTIONS.values():
-        assert corpus.category(reason) in categories, reason
+        assert corpus_report.category(reason) in categories, reason
 
 
 # --------------------------------------------------------------------------- the copy
@@ -214,7 +215,7 @@ def test_numeric_check_catches_a_wrong_derivative(monkeypatch):
 
 def test_numeric_check_skips_kinks_but_checks_smooth_points():
     from implc.errors import Source
-    from implc.parse import parse_equation
+    from implc.front import parse_equation
 
     expr = parse_equation(Source("<t>", "abs(x) + max(y, z^2) + x^(1/3) - 1"))
     verdict = corpus.numeric_check(expr, seed=3)

@@ -10,6 +10,7 @@ from cases import EXAMPLES
 
 from implc.derive import Derivatives
 from implc.emit import build_functions, emit, function_quantities
+from implc.functions import FUNCTIONS
 from implc.methods import METHODS
 from implc.numeric import evaluate, evaluate_program
 from implc.optimize import _sums_by_depth, arrange_by_depth
@@ -215,6 +216,24 @@ def test_expanded_polynomials_differentiate_as_sympy_does(seed):
         assert branch_diff(branch_diff(expr, v), x) == sympy.diff(sympy.diff(expr, v), x)
     for other in ((x + 1) ** 2 * y, sympy.sqrt(2) * x**2, x**2 * sympy.sin(y), x ** -1):
         assert not _is_expanded_rational_polynomial(other)
+
+
+@pytest.mark.parametrize("row", [f for f in FUNCTIONS if f.branch_derivative is not None],
+                         ids=lambda f: f.name)
+def test_branch_derivative_column_drives_branch_diff(row):
+    """A row with `branch_derivative` (abs, sign) is differentiated by it whatever its
+    argument: of acos(x), which sympy cannot prove real, plain sympy.diff gives re/im terms
+    or an unevaluated Derivative that no target prints; twice, so F'' branches too."""
+    from implc.derive import branch_diff
+
+    x = POINT[0]
+    inner = sympy.acos(x)
+    expr = row.build(inner)
+    assert sympy.diff(expr, x).has(sympy.re, sympy.im, sympy.Derivative)  # why the column
+    first = branch_diff(expr, x)
+    assert first == row.branch_derivative(inner) * sympy.diff(inner, x)
+    second = branch_diff(first, x)
+    assert not second.has(sympy.re, sympy.im, sympy.Derivative), second
 
 
 # An expanded degree-9 polynomial, longer than HORNER_ABOVE as written (corpus row 163's

@@ -14,7 +14,7 @@ import pytest
 from cpu_bound import cpu_limit
 
 from implc.errors import InputError, LimitError, Source
-from implc.parse import Limits, parse_equation
+from implc.front import Limits, parse_equation
 
 DATA = Path(__file__).parent / "data" / "malformed.txt"
 _ESCAPE = re.compile(r"\\(n|t|0|\\|u[0-9A-Fa-f]{4}|.)")

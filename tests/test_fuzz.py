@@ -48,8 +48,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from implc.errors import ImplcError, InputError, LimitError, Source
+from implc.front import Limits, parse_equation
 from implc.functions import BY_SYMPY_NAME, USER_FUNCTIONS
-from implc.parse import Limits, parse_equation
 from implc.symbols import X, Y, Z
 from implc.targets import TARGETS
 
@@ -65,7 +65,7 @@ PARAMS = {"a": sympy.Rational(3, 4), "b": sympy.Rational(-5, 2), "phi": sympy.Ra
 # IMPLC_FUZZ_SCALE=20, 34,976 cases: 0.46 s and 0.72 s at most, the parse one re-reading
 # a long printed equation), so each bound is 10x or more of the costliest case and 70x or
 # more of the typical one, and a busy machine cannot trip it; a real hang (the Endrass
-# octic's mutation, 81 s before parse.fold_constants) still fails.
+# octic's mutation, 81 s before front.build.fold_constants) still fails.
 PARSE_SECONDS = 5.0  # per parser case
 PATH_SECONDS = 30.0  # per whole-path case (derive + CSE + print)
 PATH_MAX_DERIVED = 60_000  # the bound on work that keeps a whole-path case small

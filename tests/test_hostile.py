@@ -360,7 +360,7 @@ def test_over_large_valid_inputs_stop_before_differentiating(equation, monkeypat
 def test_every_limit_has_its_option():
     """Each message names `--max-...`; each such option exists on compile."""
     from implc.cli import LIMIT_FLAGS
-    from implc.parse import Limits
+    from implc.front import Limits
 
     assert {f[2:].replace("-", "_") for f in LIMIT_FLAGS} == set(Limits.__dataclass_fields__)
     proc = implc("compile", "--help")

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 import sympy
 
+from implc.front import param_symbol
 from implc.jsurf import ORTHO_DISTANCE, to_jsurf
-from implc.parse import param_symbol
 from implc.scene import SHADING, camera_basis
 from implc.surface import load_surface
 from implc.symbols import X, Y, Z

@@ -24,9 +24,9 @@ from test_cli import implc
 
 from implc.emit import emit, param_uniforms
 from implc.errors import InputError
+from implc.front import param_symbol
 from implc.methods import METHODS
 from implc.metrics import compare
-from implc.parse import param_symbol
 from implc.render.run import open_runner, render
 from implc.surface import example_paths, load_surface
 from implc.symbols import X, Y, Z
@@ -89,7 +89,7 @@ def test_glsl_uniform_library_declares_prefixed_uniforms():
     from implc.validate import validate_text
 
     surface = load_surface("torus")
-    text = emit(surface, "glsl", "hessian", hessian(), emit="library", prefix="to_",
+    text = emit(surface, "glsl", "hessian", hessian(), emit_form="library", prefix="to_",
                 params="uniform")
     assert "uniform float to_u_param_R;" in text and "uniform float to_u_param_r;" in text
     assert not re.search(r"(?<![A-Za-z_])u_param_", text)
@@ -105,7 +105,7 @@ def test_wgsl_uniform_program_and_library_validate():
     assert "    u_param_R: f32," in program and "// offset 76: parameter R" in program
     assert "// offset 80: parameter r" in program and "struct size 96" in program
     assert validate(program, "torus.wgsl").ok
-    library = emit(surface, "wgsl", "hessian", hessian(), emit="library", prefix="to_",
+    library = emit(surface, "wgsl", "hessian", hessian(), emit_form="library", prefix="to_",
                    params="uniform")
     assert "var<private> to_params: to_Params = to_Params(1.0f, 0.35f);" in library
     assert validate(library, "torus-lib.wgsl").ok
@@ -139,7 +139,7 @@ def test_opencl_uniform_emits_validate(emit_form, method, precision):
         pytest.skip(f"{device.name} has no cl_khr_fp64")
     surface = load_surface("kummer")
     prefix = "k_" if emit_form == "library" else ""
-    text = emit(surface, "opencl", method, METHODS[method].defaults, emit=emit_form,
+    text = emit(surface, "opencl", method, METHODS[method].defaults, emit_form=emit_form,
                 prefix=prefix, precision=precision, params="uniform")
     real = precision
     assert f"}} {prefix}Params;" in text and f"    {real} u_param_mu;" in text
@@ -228,7 +228,7 @@ def test_opencl_library_takes_parameters_at_run_time(method):
     dev = require_opencl()
     cl = import_pyopencl()
     library = emit(load_surface("torus"), "opencl", method, METHODS[method].defaults,
-                   emit="library", prefix="to_", params="uniform")
+                   emit_form="library", prefix="to_", params="uniform")
     built = opencl_build(library + USER_KERNEL)
     assert built.program is not None, built.log
     kernel = cl.Kernel(built.program, "hits")

@@ -1,4 +1,4 @@
-"""The equation parser: grammar, semantics, limits and robustness (implc/parse.py)."""
+"""The equation parser: grammar, semantics, limits and robustness (implc/front/)."""
 
 from __future__ import annotations
 
@@ -10,11 +10,8 @@ from pathlib import Path
 import pytest
 import sympy
 
-from implc import parse as implc_parse
 from implc.errors import InputError, LimitError, Source
-from implc.functions import USER_FUNCTIONS
-from implc.parse import (
-    FOLD_DIGITS,
+from implc.front import (
     Limits,
     check_param_name,
     fold_constants,
@@ -24,6 +21,8 @@ from implc.parse import (
     parse_equation_with_params,
     parse_number,
 )
+from implc.front.build import FOLD_DIGITS, Builder
+from implc.functions import USER_FUNCTIONS
 from implc.symbols import X, Y, Z
 
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "implicit_surface_corpus.tsv"
@@ -412,7 +411,7 @@ def test_huge_powers_are_refused_before_sympy(text: str, monkeypatch) -> None:
     def no_sympy(self, root):
         raise AssertionError(f"sympy was asked to build {text!r}")
 
-    monkeypatch.setattr(implc_parse._Builder, "build", no_sympy)
+    monkeypatch.setattr(Builder, "build", no_sympy)
     with pytest.raises(LimitError):
         parse(text)
 
@@ -719,3 +718,17 @@ def test_rewrites_the_parser_folds_give_the_same_tree(text: str, rewritten: str)
     """The same tree, so the same shader text and pixels: no render needed to know it
     (tests/test_metamorphic.py renders the rewrites that reach the shader as other text)."""
     assert parse(text) == parse(rewritten)
+
+
+# The function table's `aliases` (implc/functions.py), read by the parser's hints: the test
+# loops over the rows, not over names written here.
+
+_ALIASES = [(alias, f.name) for f in USER_FUNCTIONS.values() for alias in f.aliases]
+
+
+@pytest.mark.parametrize(("alias", "name"), _ALIASES)
+def test_every_alias_in_the_table_names_its_row(alias: str, name: str) -> None:
+    assert len(_ALIASES) >= 12
+    args = ", ".join(["x"] * USER_FUNCTIONS[name].arity)
+    with pytest.raises(InputError, match=rf"unknown function '{alias}'; did you mean '{name}'\?"):
+        parse(f"{alias}({args}) - y")

@@ -131,7 +131,7 @@ def test_every_table_function_prints_and_validates(name, form):
     target = TARGETS[name]
     for precision, printer in zip(target.precisions, printers(target), strict=True):
         texts = {method: emit(every_function_surface(method == "interval"), name, method,
-                              emit=form, precision=precision)
+                              emit_form=form, precision=precision)
                  for method in ("hessian", "interval")}
         for spelling in set(printer.known_functions.values()):
             assert any(f"{spelling}(" in text for text in texts.values()), \

@@ -31,6 +31,7 @@ from browser_support import (
     ssim,
     to_8bit,
 )
+from conftest import require_tool
 from test_cli import implc
 
 from implc.methods import METHODS
@@ -94,6 +95,21 @@ def test_page_is_deterministic_and_escapes_names(tmp_path):
     page = viewer_page(load_surface(str(toml)))
     assert "<script>alert(1)" not in page
     assert page.count("</script>") == 2  # the JSON block and the viewer's script
+
+
+def test_viewer_script_parses_and_is_the_pages_script():
+    """templates/view/viewer.js is the page's script as it is (a linter reads the file the
+    browser runs), and node's parser accepts it (`make lint` runs the same check)."""
+    import subprocess
+
+    from implc.resources import data_dir
+
+    script = data_dir("templates") / "view" / "viewer.js"
+    page = viewer_page(load_surface("torus"))
+    assert "<script>\n" + script.read_text(encoding="utf-8") + "</script>" in page
+    node = require_tool("node")
+    result = subprocess.run([node, "--check", str(script)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
 
 
 def test_cli_view_writes_the_page(tmp_path):

@@ -188,24 +188,24 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
         // every piece end are evaluated once, before the walk: a SIMD group needs each of
         // them for some lane.
         float d = P3(ray, lo);
-        float fe0 = P4(ray, x2_0);
-        float de0 = P3(ray, x2_0);
-        float fe1 = P4(ray, x2_1);
-        float de1 = P3(ray, x2_1);
-        float fe2 = P4(ray, hi);
-        float de2 = P3(ray, hi);
+        float f_end0 = P4(ray, x2_0);
+        float d_end0 = P3(ray, x2_0);
+        float f_end1 = P4(ray, x2_1);
+        float d_end1 = P3(ray, x2_1);
+        float f_end2 = P4(ray, hi);
+        float d_end2 = P3(ray, hi);
         int start = 0;
-        float gp = lo;
-        float gq = lo;
-        float gf = 0.0;
-        float gd = 0.0;
-        float gdq = 0.0;
+        float graze_a = lo;
+        float graze_b = lo;
+        float graze_fa = 0.0;
+        float graze_da = 0.0;
+        float graze_db = 0.0;
         for (int round = 0; round < 3; ++round) {
             bool pending = false;
             if (!found && !pending && start <= 0) {
                 float q = x2_0;
-                float fq = fe0;
-                float dq = de0;
+                float fq = f_end0;
+                float dq = d_end0;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
@@ -216,11 +216,11 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 1;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -228,8 +228,8 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
             }
             if (!found && !pending && start <= 1) {
                 float q = x2_1;
-                float fq = fe1;
-                float dq = de1;
+                float fq = f_end1;
+                float dq = d_end1;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
@@ -240,11 +240,11 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 2;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -252,8 +252,8 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
             }
             if (!found && !pending && start <= 2) {
                 float q = hi;
-                float fq = fe2;
-                float dq = de2;
+                float fq = f_end2;
+                float dq = d_end2;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
@@ -264,11 +264,11 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 3;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -276,17 +276,17 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
             }
             // One Newton loop for every lane with something to solve, whichever it is: the
             // root of F = P4 in its bracket [a, b] (mode 1), or the extremum of the piece
-            // that stopped the walk, the root of F' = P3 in [gp, gq] (mode 2), after
+            // that stopped the walk, the root of F' = P3 in [graze_a, graze_b] (mode 2), after
             // which F at it decides (mode 3): a touching root, a sign change before it (mode
-            // 1 on [gp, m]), or neither (the walk goes on after it). One loop, not one per
+            // 1 on [graze_a, m]), or neither (the walk goes on after it). One loop, not one per
             // kind: a loop runs at least once for a SIMD group, even one with no lane in it
             // (measured: the extremum's own loop cost 18-26 % of the frame on the quartics).
             int mode = (bracket ? 1 : (pending ? 2 : 0));
             if (pending) {
-                a = gp;
-                b = gq;
-                fa = gd;
-                fb = gdq;
+                a = graze_a;
+                b = graze_b;
+                fa = graze_da;
+                fb = graze_db;
             }
             float x = (fb != fa ? a - fa*(b - a)/(fb - fa) : 0.5*(a + b));
             if (pending && (fa == 0.0 || !(a < b))) {
@@ -307,14 +307,14 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
                         found = true;
                         u = x;
                         mode = 0;
-                    } else if (gf*f_x <= 0.0) {
+                    } else if (graze_fa*f_x <= 0.0) {
                         found = true;
                         mode = 1;
                         tries = 0;
-                        a = gp;
+                        a = graze_a;
                         b = x;
-                        fa = gf;
-                        x = (f_x != gf ? gp - gf*(x - gp)/(f_x - gf) : 0.5*(gp + x));
+                        fa = graze_fa;
+                        x = (f_x != graze_fa ? graze_a - graze_fa*(x - graze_a)/(f_x - graze_fa) : 0.5*(graze_a + x));
                     } else {
                         again = true;
                         mode = 0;
@@ -333,9 +333,9 @@ Hit trace(vec3 ro, vec3 rd, float t0, float t1) {
                     // Halley's step where its correction is moderate (|g g''| < dg^2):
                     // x - g dg/(dg^2 - g g''/2), cubic convergence; else Newton's.
                     // One division either way (the slow operation of the loop).
-                    float gg = dg*dg;
-                    float gh = g*(root ? dd_x : 0.0);
-                    float next = x - g*dg/(gg - (abs(gh) < gg ? 0.5*gh : 0.0));
+                    float dg_sq = dg*dg;
+                    float g_ddg = g*(root ? dd_x : 0.0);
+                    float next = x - g*dg/(dg_sq - (abs(g_ddg) < dg_sq ? 0.5*g_ddg : 0.0));
                     if (dg == 0.0 || !(next >= a && next <= b)) {
                         next = 0.5*(a + b);
                     }

@@ -192,24 +192,24 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
         // every piece end are evaluated once, before the walk: a SIMD group needs each of
         // them for some lane.
         double d = P3(ray, lo);
-        double fe0 = P4(ray, x2_0);
-        double de0 = P3(ray, x2_0);
-        double fe1 = P4(ray, x2_1);
-        double de1 = P3(ray, x2_1);
-        double fe2 = P4(ray, hi);
-        double de2 = P3(ray, hi);
+        double f_end0 = P4(ray, x2_0);
+        double d_end0 = P3(ray, x2_0);
+        double f_end1 = P4(ray, x2_1);
+        double d_end1 = P3(ray, x2_1);
+        double f_end2 = P4(ray, hi);
+        double d_end2 = P3(ray, hi);
         int start = 0;
-        double gp = lo;
-        double gq = lo;
-        double gf = 0.0;
-        double gd = 0.0;
-        double gdq = 0.0;
+        double graze_a = lo;
+        double graze_b = lo;
+        double graze_fa = 0.0;
+        double graze_da = 0.0;
+        double graze_db = 0.0;
         for (int round = 0; round < 3; ++round) {
             bool pending = false;
             if (!found && !pending && start <= 0) {
                 double q = x2_0;
-                double fq = fe0;
-                double dq = de0;
+                double fq = f_end0;
+                double dq = d_end0;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
@@ -220,11 +220,11 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 1;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -232,8 +232,8 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
             }
             if (!found && !pending && start <= 1) {
                 double q = x2_1;
-                double fq = fe1;
-                double dq = de1;
+                double fq = f_end1;
+                double dq = d_end1;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
@@ -244,11 +244,11 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 2;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -256,8 +256,8 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
             }
             if (!found && !pending && start <= 2) {
                 double q = hi;
-                double fq = fe2;
-                double dq = de2;
+                double fq = f_end2;
+                double dq = d_end2;
                 if (f*fq <= 0.0) {
                     found = true;
                     bracket = true;
@@ -268,11 +268,11 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
                 } else if (d*dq < 0.0 && f*d < 0.0) {
                     pending = true;
                     start = 3;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -280,17 +280,17 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
             }
             // One Newton loop for every lane with something to solve, whichever it is: the
             // root of F = P4 in its bracket [a, b] (mode 1), or the extremum of the piece
-            // that stopped the walk, the root of F' = P3 in [gp, gq] (mode 2), after
+            // that stopped the walk, the root of F' = P3 in [graze_a, graze_b] (mode 2), after
             // which F at it decides (mode 3): a touching root, a sign change before it (mode
-            // 1 on [gp, m]), or neither (the walk goes on after it). One loop, not one per
+            // 1 on [graze_a, m]), or neither (the walk goes on after it). One loop, not one per
             // kind: a loop runs at least once for a SIMD group, even one with no lane in it
             // (measured: the extremum's own loop cost 18-26 % of the frame on the quartics).
             int mode = (bracket ? 1 : (pending ? 2 : 0));
             if (pending) {
-                a = gp;
-                b = gq;
-                fa = gd;
-                fb = gdq;
+                a = graze_a;
+                b = graze_b;
+                fa = graze_da;
+                fb = graze_db;
             }
             double x = (fb != fa ? a - fa*(b - a)/(fb - fa) : 0.5*(a + b));
             if (pending && (fa == 0.0 || !(a < b))) {
@@ -311,14 +311,14 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
                         found = true;
                         u = x;
                         mode = 0;
-                    } else if (gf*f_x <= 0.0) {
+                    } else if (graze_fa*f_x <= 0.0) {
                         found = true;
                         mode = 1;
                         tries = 0;
-                        a = gp;
+                        a = graze_a;
                         b = x;
-                        fa = gf;
-                        x = (f_x != gf ? gp - gf*(x - gp)/(f_x - gf) : 0.5*(gp + x));
+                        fa = graze_fa;
+                        x = (f_x != graze_fa ? graze_a - graze_fa*(x - graze_a)/(f_x - graze_fa) : 0.5*(graze_a + x));
                     } else {
                         again = true;
                         mode = 0;
@@ -337,9 +337,9 @@ Hit trace(double3 ro, double3 rd, double t0, double t1) {
                     // Halley's step where its correction is moderate (|g g''| < dg^2):
                     // x - g dg/(dg^2 - g g''/2), cubic convergence; else Newton's.
                     // One division either way (the slow operation of the loop).
-                    double gg = dg*dg;
-                    double gh = g*(root ? dd_x : 0.0);
-                    double next = x - g*dg/(gg - (fabs(gh) < gg ? 0.5*gh : 0.0));
+                    double dg_sq = dg*dg;
+                    double g_ddg = g*(root ? dd_x : 0.0);
+                    double next = x - g*dg/(dg_sq - (fabs(g_ddg) < dg_sq ? 0.5*g_ddg : 0.0));
                     if (dg == 0.0 || !(next >= a && next <= b)) {
                         next = 0.5*(a + b);
                     }

@@ -198,24 +198,24 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         // every piece end are evaluated once, before the walk: a SIMD group needs each of
         // them for some lane.
         var d: f32 = P3(ray, lo);
-        let fe0: f32 = P4(ray, x2_0);
-        let de0: f32 = P3(ray, x2_0);
-        let fe1: f32 = P4(ray, x2_1);
-        let de1: f32 = P3(ray, x2_1);
-        let fe2: f32 = P4(ray, hi);
-        let de2: f32 = P3(ray, hi);
+        let f_end0: f32 = P4(ray, x2_0);
+        let d_end0: f32 = P3(ray, x2_0);
+        let f_end1: f32 = P4(ray, x2_1);
+        let d_end1: f32 = P3(ray, x2_1);
+        let f_end2: f32 = P4(ray, hi);
+        let d_end2: f32 = P3(ray, hi);
         var start: i32 = 0;
-        var gp: f32 = lo;
-        var gq: f32 = lo;
-        var gf: f32 = 0.0f;
-        var gd: f32 = 0.0f;
-        var gdq: f32 = 0.0f;
+        var graze_a: f32 = lo;
+        var graze_b: f32 = lo;
+        var graze_fa: f32 = 0.0f;
+        var graze_da: f32 = 0.0f;
+        var graze_db: f32 = 0.0f;
         for (var round: i32 = 0; round < 3; round++) {
             var pending: bool = false;
             if (!found && !pending && start <= 0) {
                 let q: f32 = x2_0;
-                let fq: f32 = fe0;
-                let dq: f32 = de0;
+                let fq: f32 = f_end0;
+                let dq: f32 = d_end0;
                 if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
@@ -226,11 +226,11 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 } else if (d*dq < 0.0f && f*d < 0.0f) {
                     pending = true;
                     start = 1;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -238,8 +238,8 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             }
             if (!found && !pending && start <= 1) {
                 let q: f32 = x2_1;
-                let fq: f32 = fe1;
-                let dq: f32 = de1;
+                let fq: f32 = f_end1;
+                let dq: f32 = d_end1;
                 if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
@@ -250,11 +250,11 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 } else if (d*dq < 0.0f && f*d < 0.0f) {
                     pending = true;
                     start = 2;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -262,8 +262,8 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             }
             if (!found && !pending && start <= 2) {
                 let q: f32 = hi;
-                let fq: f32 = fe2;
-                let dq: f32 = de2;
+                let fq: f32 = f_end2;
+                let dq: f32 = d_end2;
                 if (f*fq <= 0.0f) {
                     found = true;
                     bracket = true;
@@ -274,11 +274,11 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 } else if (d*dq < 0.0f && f*d < 0.0f) {
                     pending = true;
                     start = 3;
-                    gp = p;
-                    gq = q;
-                    gf = f;
-                    gd = d;
-                    gdq = dq;
+                    graze_a = p;
+                    graze_b = q;
+                    graze_fa = f;
+                    graze_da = d;
+                    graze_db = dq;
                 }
                 p = q;
                 f = fq;
@@ -286,17 +286,17 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             }
             // One Newton loop for every lane with something to solve, whichever it is: the
             // root of F = P4 in its bracket [a, b] (mode 1), or the extremum of the piece
-            // that stopped the walk, the root of F' = P3 in [gp, gq] (mode 2), after
+            // that stopped the walk, the root of F' = P3 in [graze_a, graze_b] (mode 2), after
             // which F at it decides (mode 3): a touching root, a sign change before it (mode
-            // 1 on [gp, m]), or neither (the walk goes on after it). One loop, not one per
+            // 1 on [graze_a, m]), or neither (the walk goes on after it). One loop, not one per
             // kind: a loop runs at least once for a SIMD group, even one with no lane in it
             // (measured: the extremum's own loop cost 18-26 % of the frame on the quartics).
             var mode: i32 = select(select(0, 2, pending), 1, bracket);
             if (pending) {
-                a = gp;
-                b = gq;
-                fa = gd;
-                fb = gdq;
+                a = graze_a;
+                b = graze_b;
+                fa = graze_da;
+                fb = graze_db;
             }
             var x: f32 = select(0.5f*(a + b), a - fa*(b - a)/(fb - fa), fb != fa);
             if (pending && (fa == 0.0f || !(a < b))) {
@@ -317,14 +317,14 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                         found = true;
                         u = x;
                         mode = 0;
-                    } else if (gf*f_x <= 0.0f) {
+                    } else if (graze_fa*f_x <= 0.0f) {
                         found = true;
                         mode = 1;
                         tries = 0;
-                        a = gp;
+                        a = graze_a;
                         b = x;
-                        fa = gf;
-                        x = select(0.5f*(gp + x), gp - gf*(x - gp)/(f_x - gf), f_x != gf);
+                        fa = graze_fa;
+                        x = select(0.5f*(graze_a + x), graze_a - graze_fa*(x - graze_a)/(f_x - graze_fa), f_x != graze_fa);
                     } else {
                         again = true;
                         mode = 0;
@@ -343,9 +343,9 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                     // Halley's step where its correction is moderate (|g g''| < dg^2):
                     // x - g dg/(dg^2 - g g''/2), cubic convergence; else Newton's.
                     // One division either way (the slow operation of the loop).
-                    let gg: f32 = dg*dg;
-                    let gh: f32 = g*select(0.0f, dd_x, root);
-                    var next: f32 = x - g*dg/(gg - select(0.0f, 0.5f*gh, abs(gh) < gg));
+                    let dg_sq: f32 = dg*dg;
+                    let g_ddg: f32 = g*select(0.0f, dd_x, root);
+                    var next: f32 = x - g*dg/(dg_sq - select(0.0f, 0.5f*g_ddg, abs(g_ddg) < dg_sq));
                     if (dg == 0.0f || !(next >= a && next <= b)) {
                         next = 0.5f*(a + b);
                     }
