@@ -71,6 +71,12 @@ class Function:
     # u -> d f(u)/du by branch, for every u (sympy gives abs and sign a derivative only
     # where it can prove u real); derive.branch_diff differentiates the row with it
     branch_derivative: Callable[[sympy.Expr], sympy.Expr] | None = None
+    # how a shader prints it (implc/backends/printing.py): "call", a call spelled by each
+    # printer's `known_functions`; "fold", such calls of two arguments as a balanced tree
+    # (min, max); "step", the printer's `print_step` (Heaviside: OpenCL prints a select);
+    # "zero", the literal 0 (DiracDelta, 0 almost everywhere). Only "call" and "fold" rows
+    # have spellings.
+    printed: str = "call"
 
 
 def _heaviside(x, *_):
@@ -180,9 +186,9 @@ FUNCTIONS: tuple[Function, ...] = (
              aliases=("sgn",), branch_derivative=lambda u: 2 * sympy.DiracDelta(u)),
     # min and max take their arguments' bounds apart (implc/interval.py)
     Function("min", 2, sympy.Min, "Min", np.minimum, "smooth union in CSG; derivative by branch",
-             variadic=True, unevaluated=True, aliases=("fmin",)),
+             variadic=True, unevaluated=True, aliases=("fmin",), printed="fold"),
     Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch", variadic=True,
-             unevaluated=True, aliases=("fmax",)),
+             unevaluated=True, aliases=("fmax",), printed="fold"),
     # Only in derivatives: the step of min/max/abs and the (ignored) spike of sign.
     Function("step", 1, sympy.Heaviside, "Heaviside", _heaviside,
              "derivative of min/max; 1 for x > 0, 0 for x < 0; at 0, 0.5 on the CPU and 1 "
@@ -190,9 +196,10 @@ FUNCTIONS: tuple[Function, ...] = (
              "where the CPU's is their mean: the same direction (normals agree), F' twice "
              "as large (Newton is safeguarded)", user=False,
              interval=lambda lo, hi, let: (sympy.Heaviside(lo), sympy.Heaviside(hi),
-                                           sympy.false)),
+                                           sympy.false), printed="step"),
     Function("delta", 1, sympy.DiracDelta, "DiracDelta", lambda x, *_: np.zeros_like(x),
-             "derivative of sign(x); taken as 0 (almost everywhere)", user=False),
+             "derivative of sign(x); taken as 0 (almost everywhere)", user=False,
+             printed="zero"),
     # Only in interval rules (sin, cos, tan: which period an end lies in).
     Function("floor", 1, sympy.floor, "floor", np.floor, "largest integer <= x", user=False),
 )

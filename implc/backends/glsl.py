@@ -8,7 +8,8 @@ from sympy.printing.glsl import GLSLPrinter
 from .printing import ShaderPrinterMixin
 
 # sympy class name -> GLSL function, for every row of implc/functions.py that prints as a
-# call (the others: printing.RULES). GLSL's two-argument arctangent is an overload of atan.
+# call (the others: the table's `printed` column). GLSL's two-argument arctangent is an
+# overload of atan.
 known_functions = {
     "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
     "atan2": "atan", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "exp": "exp",

@@ -13,7 +13,7 @@ from sympy.printing.c import C99CodePrinter
 from .printing import ShaderPrinterMixin
 
 # sympy class name -> HLSL intrinsic, for every row of implc/functions.py that prints as
-# a call (the others: printing.RULES).
+# a call (the others: the table's `printed` column).
 known_functions = {
     "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
     "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "exp": "exp",

@@ -20,8 +20,8 @@ PRECISIONS = ("float", "double")
 LITERAL_SUFFIX = {"float": "f", "double": ""}
 
 # sympy class name -> OpenCL C built-in, for every row of implc/functions.py that prints as
-# a call (the others: printing.RULES). The float forms of abs/min/max are fabs/fmin/fmax;
-# every built-in here is overloaded for float and double.
+# a call (the others: the table's `printed` column). The float forms of abs/min/max are
+# fabs/fmin/fmax; every built-in here is overloaded for float and double.
 known_functions = {
     "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
     "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "exp": "exp",

@@ -5,7 +5,7 @@ attributes, and its module's `known_functions` (sympy's idiom: sympy class name 
 target's function name) as `_kf`. The mixin fixes what sympy gets wrong for shaders: typed
 float literals for every number (`2` -> `2.0`), no `pow` for integer powers (the optimizer
 already turned them into products), constants as literals, exactly the functions of
-`functions.FUNCTIONS` (each spelled by `known_functions` or printed by one of `RULES`),
+`functions.FUNCTIONS` (printed as the table's `printed` column says),
 and an implc error (not a driver error) for anything unsupported.
 """
 
@@ -17,13 +17,9 @@ from sympy.printing.precedence import PRECEDENCE, precedence
 from ..errors import ImplcError, InputError
 from ..functions import BY_SYMPY_NAME
 
-# Rows of the function table printed by a rule of the mixin, not spelled by a printer's
-# `known_functions`, and why. Every other row needs a spelling in every printer.
-RULES: dict[str, str] = {
-    "Heaviside": "the derivative of min/max/abs by branch: `print_step`, which a target "
-                 "may override (OpenCL prints a select)",
-    "DiracDelta": "the derivative of sign: 0 almost everywhere, printed as the literal 0",
-}
+# How each row prints is the table's `printed` column: rows printed "call" or "fold" are
+# spelled by every printer's `known_functions`; "step" and "zero" rows by the mixin below.
+SPELLED = ("call", "fold")
 
 
 FLOAT32_MAX = 3.4028234663852886e38
@@ -122,14 +118,14 @@ class ShaderPrinterMixin:
         row = BY_SYMPY_NAME.get(name)
         if row is None:
             raise ImplcError(f"function '{name}' cannot be printed for target {self.target}")
-        if name == "Heaviside":
+        if row.printed == "step":
             return self.print_step(self._print(expr.args[0]))
-        if name == "DiracDelta":
+        if row.printed == "zero":
             return self.float_literal(0.0)
         spelled = self.known_functions.get(name)
         if not spelled:
             raise ImplcError(f"function '{row.name}' has no {self.target} spelling")
-        if name in ("Min", "Max"):
+        if row.printed == "fold":
             return self._fold(spelled, expr.args)
         return f"{spelled}({', '.join(self._print(a) for a in expr.args)})"
 

@@ -46,7 +46,7 @@ RESERVED = frozenset((
 RESERVED_WORDS = KEYWORDS | RESERVED
 
 # sympy class name -> WGSL built-in, for every row of implc/functions.py that prints as a
-# call (the others: printing.RULES).
+# call (the others: the table's `printed` column).
 known_functions = {
     "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
     "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "exp": "exp",
