@@ -38,7 +38,6 @@ from pathlib import Path
 
 import numpy as np
 import sympy
-from sympy.printing.str import StrPrinter
 
 from .errors import InputError, Source
 from .fileio import read_input
@@ -47,6 +46,7 @@ from .limits import Limits
 from .scene import SHADING, View, view_problems
 from .surface import MAX_FILE_BYTES, Surface
 from .symbols import X, Y, Z
+from .textform import EquationPrinter
 
 # an orthographic camera's eye, in clip radii from the target (at 1000 float32 shaders
 # speckle: the eye is too far for the entry point's precision)
@@ -582,9 +582,10 @@ def _vec(v) -> tuple[float, float, float]:
 
 # --------------------------------------------------------------------------- writing
 
-class _JsurfPrinter(StrPrinter):
-    """sympy -> jsurf's grammar: explicit `*`, `^` with whole-number exponents on x, y,
-    z, functions only of constants (the caller checks the surface is a polynomial)."""
+class _JsurfPrinter(EquationPrinter):
+    """sympy -> jsurf's grammar: implc's equation text (its decimals and fractions) with
+    explicit `*`, `^` with whole-number exponents on x, y, z, functions only of constants
+    (the caller checks the surface is a polynomial)."""
 
     _FUNCTIONS = {"sin", "cos", "tan", "asin", "acos", "atan", "exp", "log", "Abs", "sign"}
 
@@ -598,22 +599,7 @@ class _JsurfPrinter(StrPrinter):
 
     _print_Abs = _print_Function
 
-    def _print_Float(self, expr):
-        return repr(float(expr))
-
-    def _print_Rational(self, expr):
-        if expr.q > 1000:
-            return repr(float(expr))
-        return f"{expr.p}/{expr.q}" if expr.q != 1 else str(expr.p)
-
-    def _print_Mul(self, expr):
-        """A long decimal coefficient (a parameter's 0.5067166) as that decimal, not as
-        a fraction of 15-digit integers."""
-        coeff, rest = expr.as_coeff_Mul()
-        if coeff.is_Rational and coeff.q > 1000 and rest != 1:
-            sign = "-" if coeff < 0 else ""
-            return f"{sign}{repr(float(abs(coeff)))}*{self.parenthesize(rest, 50, strict=True)}"
-        return super()._print_Mul(expr)
+    _print_Min = _print_Max = _print_Function  # not in jsurf's grammar: refused
 
     def _print_Pi(self, expr):
         return repr(math.pi)

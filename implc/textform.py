@@ -12,7 +12,9 @@ _NAMES = {f.sympy_name: f.name for f in FUNCTIONS
           if f.user and f.sympy_name and f.sympy_name != f.name}
 
 
-class _EquationPrinter(StrPrinter):
+class EquationPrinter(StrPrinter):
+    """sympy -> implc's input language (`jsurf` writes SURFER's dialect on top of it)."""
+
     def _print_Function(self, expr):
         name = _NAMES.get(type(expr).__name__, type(expr).__name__)
         return f"{name}({', '.join(self._print(a) for a in expr.args)})"
@@ -74,4 +76,4 @@ def to_text(expr: sympy.Expr) -> str:
 def value_text(expr: sympy.Expr) -> str:
     """`expr` in implc's input language: a parameter's value (`7/20`, `1.618033988749895`
     for a long decimal, `1/2 + sqrt(5)/2`)."""
-    return _EquationPrinter({"order": "lex"}).doprint(expr)
+    return EquationPrinter({"order": "lex"}).doprint(expr)
