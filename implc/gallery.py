@@ -65,9 +65,8 @@ def run_gallery(specs: list[str], out_dir: Path, size: int = 160, backend: str =
             cell, image = _one(spec, stem, stage, size, backend, webgpu, bar)
             cells.append(cell)
             images.append(image)
-            bar.step(f"{cell.name or spec}: " + (f"error: {cell.error.splitlines()[0]}"
-                                                  if cell.error else
-                                                  f"{cell.method}, {cell.frame_ms:.1f} ms"))
+            bar.step(cell.error.splitlines()[0] if cell.error else
+                     f"{cell.name or spec}: {cell.method}, {cell.frame_ms:.1f} ms")
         write_atomic(stage / "index.html", render_template(
             "gallery/index.html.j2", cells=[dataclasses.asdict(c) for c in cells],
             size=size, backend=backend))
