@@ -149,6 +149,13 @@ def _install_signals() -> dict:
     for sig, handler in ((signal.SIGTERM, _on_sigterm), (signal.SIGXFSZ, signal.SIG_IGN)):
         with contextlib.suppress(ValueError, OSError):  # not the main thread
             previous[sig] = signal.signal(sig, handler)
+    # Restart system calls the signal interrupts (SA_RESTART) instead of failing them
+    # with EINTR: Mesa's shader compile does not retry one, and a Ctrl-C during
+    # moderngl's ctx.program segfaulted (test_fault[gallery-SIGINT]: 2 runs of 6; 0 of 14
+    # with this). Python still raises KeyboardInterrupt once the call returns.
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        with contextlib.suppress(ValueError, OSError):
+            signal.siginterrupt(sig, False)
     return previous
 
 
