@@ -115,7 +115,8 @@ def _solver_lines(degree: int) -> list[str]:
         shift = degree * (degree + 1) // 2
         return [f"  strategy: Bernstein subdivision (degree >= {BERNSTEIN_FROM}): per node a "
                 f"Taylor shift ({shift} multiply-adds), {degree} scalings and {degree} "
-                f"Bernstein sums; 3-6 nodes a ray measured, at most {BERNSTEIN_MAX_NODES}; "
+                f"Bernstein sums; 2-6 nodes a ray on average (measured), at most "
+                f"{BERNSTEIN_MAX_NODES}; "
                 "Newton on F with F' by Estrin's scheme"]
     return [f"  strategy: critical points level by level (degree < {BERNSTEIN_FROM}): "
             f"derivatives P1..P{degree - 1} of F by Estrin's scheme"]
