@@ -150,9 +150,10 @@ def _install_signals() -> dict:
         with contextlib.suppress(ValueError, OSError):  # not the main thread
             previous[sig] = signal.signal(sig, handler)
     # Restart system calls the signal interrupts (SA_RESTART) instead of failing them
-    # with EINTR: Mesa's shader compile does not retry one, and a Ctrl-C during
-    # moderngl's ctx.program segfaulted (test_fault[gallery-SIGINT]: 2 runs of 6; 0 of 14
-    # with this). Python still raises KeyboardInterrupt once the call returns.
+    # with EINTR, which C libraries may not retry: a Ctrl-C during moderngl's ctx.program
+    # segfaulted (test_fault[gallery-SIGINT]: 2 runs of 6; 0 of 14 with this, but once
+    # more in a loaded clean-clone run, so render/gl.py also holds the signals while the
+    # driver works). Python still raises KeyboardInterrupt once the call returns.
     for sig in (signal.SIGINT, signal.SIGTERM):
         with contextlib.suppress(ValueError, OSError):
             signal.siginterrupt(sig, False)

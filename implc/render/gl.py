@@ -7,7 +7,9 @@ Rows are flipped on readback so row 0 is the top of the image, like every runner
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+import signal
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from functools import lru_cache
 
 import numpy as np
@@ -22,6 +24,25 @@ from .result import RenderResult, TimedRunner
 TRIANGLES = 0x0004  # GL_TRIANGLES
 
 
+@contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM wait, blocked in this thread, while the driver works: a Ctrl-C
+    that landed inside Mesa's shader compile (moderngl's ctx.program) segfaulted the
+    process (test_fault[gallery-SIGINT], about 1 run in 4 under load); Python raises it
+    as soon as the block ends. Threads the driver starts meanwhile (llvmpipe's) inherit
+    the block, so the signal is always taken by this thread."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    try:
+        before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    except (AttributeError, ValueError, OSError):  # no pthreads
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
 @lru_cache(maxsize=1)
 def context():
     """One standalone EGL context per process (creating one costs ~0.1 s)."""
@@ -31,7 +52,8 @@ def context():
         raise ToolError("moderngl is not installed (run `make setup`)") from err
     os.environ.setdefault("XDG_RUNTIME_DIR", "/tmp")
     try:
-        return moderngl.create_standalone_context(backend="egl", require=330)
+        with signals_held():
+            return moderngl.create_standalone_context(backend="egl", require=330)
     except Exception as err:  # moderngl raises plain Exception subclasses
         raise ToolError(f"cannot create a headless OpenGL context (EGL): {err}") from err
 
@@ -47,7 +69,8 @@ class GlRunner(TimedRunner):
                  params: Sequence[ParamUniform] = ()):
         ctx = context()
         try:
-            self.program = ctx.program(vertex_shader=vertex, fragment_shader=fragment)
+            with signals_held():
+                self.program = ctx.program(vertex_shader=vertex, fragment_shader=fragment)
         except Exception as err:
             raise ToolError(f"the GL driver rejected the shader: {err}") from err
         self.width, self.height = width, height
@@ -89,10 +112,11 @@ class GlRunner(TimedRunner):
         """One pixel drawn and waited for: llvmpipe compiles the fragment shader at its
         first draw whatever the viewport (measured: the full frame after it takes what
         every later frame takes); `draw` sets the whole viewport again."""
-        self.fbo.use()
-        self.fbo.viewport = (0, 0, 1, 1)
-        self.vao.render(mode=TRIANGLES, vertices=3)
-        context().finish()
+        with signals_held():
+            self.fbo.use()
+            self.fbo.viewport = (0, 0, 1, 1)
+            self.vao.render(mode=TRIANGLES, vertices=3)
+            context().finish()
 
     def read(self) -> RenderResult:
         shape = (self.height, self.width, 4)
