@@ -90,14 +90,15 @@ class Solver:
     # "levels" (critical points level by level) or "bernstein" (subdivision with
     # Descartes' rule of signs), by degree: see BERNSTEIN_FROM
     strategy: str = "levels"
-    # bernstein: the lets (name, printed value) that give b0..bn, the Bernstein
-    # coefficients of sum e_k w^k on w in [-1, 1] (see bernstein_lets), and the depth of
-    # a leaf node
-    bernstein: tuple[tuple[str, str], ...] = ()
+    # bernstein: the lets (name, printed value, pairs closed) that give b0..bn, the
+    # Bernstein coefficients of sum e_k w^k on w in [-1, 1] (see bernstein_lets), and the
+    # depth of a leaf node
+    bernstein: tuple[tuple[str, str, tuple[int, ...]], ...] = ()
     depth: int = 0
     # bernstein: w_i = -1 + 2i/n (printed), where b_i sits in the node's control polygon,
-    # whose zero starts the Newton (see lower_solver)
+    # whose zero starts the Newton (see lower_solver), and 2/n, their spacing
     control_w: tuple[str, ...] = ()
+    control_step: str = ""
     # bernstein: the Newton after the walk takes F's robust value (ROBUST_NEWTON_BELOW)
     robust_newton: bool = False
 
@@ -180,7 +181,8 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         control_w = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
         robust_newton = n < ROBUST_NEWTON_BELOW
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
-                        BERNSTEIN_DEPTH, control_w, robust_newton)
+                        BERNSTEIN_DEPTH, control_w, printer.float_literal(2 / n),
+                        robust_newton)
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
@@ -193,7 +195,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                    empty, solver, carried)
 
 
-def bernstein_lets(n: int, printer) -> tuple[tuple[str, str], ...]:
+def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], ...]:
     """b_0..b_n, the Bernstein coefficients of a node's polynomial sum_k e_k w^k on
     w in [-1, 1] (e_k: the Taylor coefficients about the node's middle, scaled to its half
     width): b_i = sum_k beta_ik e_k with beta_ik = sum_j C(i, j) C(n-i, k-j) (-1)^(k-j) /
@@ -201,20 +203,30 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str], ...]:
     rounding of b is bounded by n eps sum |e_k| (about the node's start, as before, the
     bound grew like 3^n sum |e_k|: 57 wrong or missed pixels of 16,384 at degree 14).
     beta_(n-i),k = (-1)^k beta_ik: the even part (k even) and the odd part are summed once
-    for i <= n/2 and give b_i and b_(n-i) by a sum and a difference."""
+    for i <= n/2 and give b_i and b_(n-i) by a sum and a difference. With each let, the
+    j of every pair (b_(j-1), b_j) whose sign change can be counted after it."""
     e = [sym(f"e{k}") for k in range(n + 1)]
 
     def beta(i: int, k: int) -> sympy.Rational:
         return sympy.Rational(sum(comb(i, j) * comb(n - i, k - j) * (-1) ** (k - j)
                                   for j in range(k + 1)), comb(n, k))
 
-    lets: list[tuple[str, str]] = []
+    lets: list[tuple[str, str, tuple[int, ...]]] = []
+    known: set[int] = set()
+
+    def coefficient(i: int, value: str) -> None:
+        # after b_i, the pairs (b_(j-1), b_j) it completes, j in (i, i + 1)
+        known.add(i)
+        lets.append((f"b{i}", value, tuple(j for j in (i, i + 1)
+                                            if j - 1 in known and j in known)))
+
     for i in range(n // 2 + 1):
         even = sympy.Add(*(beta(i, k) * e[k] for k in range(0, n + 1, 2)))
         odd = sympy.Add(*(beta(i, k) * e[k] for k in range(1, n + 1, 2)))
         if 2 * i == n:  # the middle coefficient: its odd part is 0
-            lets.append((f"b{i}", printer.doprint(even)))
+            coefficient(i, printer.doprint(even))
             continue
-        lets += [(f"be{i}", printer.doprint(even)), (f"bo{i}", printer.doprint(odd)),
-                 (f"b{i}", f"be{i} + bo{i}"), (f"b{n - i}", f"be{i} - bo{i}")]
+        lets += [(f"be{i}", printer.doprint(even), ()), (f"bo{i}", printer.doprint(odd), ())]
+        coefficient(i, f"be{i} + bo{i}")
+        coefficient(n - i, f"be{i} - bo{i}")
     return tuple(lets)

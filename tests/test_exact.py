@@ -116,6 +116,26 @@ def test_walk_resumes_after_a_grazing_piece():
     np.testing.assert_allclose(got[:, 1], expected, atol=1e-4)
 
 
+def test_bernstein_walk_resumes_after_a_leaf():
+    """A near-double root float32 cannot separate: S = ((x^2+y^2+z^2-1)^2 + 1e-7)
+    ((x-3)^2+y^2+z^2-1.21), degree 6, is positive near the unit sphere (F >= 2e-6 along
+    these rays), so the first root is on the sphere of radius 1.1 about (3, 0, 0). Rays
+    along x across the unit sphere stop at leaves there (measured: 25 of these 64), whose
+    touch test runs after the walk's loop; the walk must go on after each and find the
+    second sphere. Fails when the walk ends at such a leaf (every one of those rays
+    misses)."""
+    from implc.solver import BERNSTEIN_FROM
+
+    require_gl()
+    surface = load_surface(
+        equation="((x^2+y^2+z^2 - 1)^2 + 1e-7)*((x-3)^2 + y^2 + z^2 - 1.21) = 0")
+    assert polynomial_degree(surface.expr) >= BERNSTEIN_FROM
+    ys = np.linspace(0.0, 0.9, 64)
+    got = intersect(surface, "exact", [((-2.0, y, 0.0), (1, 0, 0), 0.0, 6.5) for y in ys])
+    assert np.all(got[:, 0] == 1), got
+    np.testing.assert_allclose(got[:, 1], 5.0 - np.sqrt(1.21 - ys * ys), atol=1e-4)
+
+
 @pytest.mark.parametrize("example", ["gyroid", "blobs"])
 def test_exact_refuses_non_polynomials(example):
     with pytest.raises(InputError, match="needs a polynomial surface.*use one of"):
