@@ -16,6 +16,7 @@ Mesa's shader cache off).
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import statistics
 import time
@@ -162,11 +163,16 @@ def rows_from_table(path: str) -> list:
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
         if len(cells) != 12 or not cells[1].isdigit():
             continue
-        ms = [float(c) for c in cells[2:6]]
+        ms = [_number(c) for c in cells[2:6]]
         r = {key: {"ms": m} for key, m in zip(SWEEP_RUNS, ms, strict=True)}
-        r["exact", "auto"].update(emit_s=float(cells[10]), driver_s=float(cells[11]))
-        rows.append((cells[0], int(cells[1]), r, float(cells[6])))
+        r["exact", "auto"].update(emit_s=_number(cells[10]), driver_s=_number(cells[11]))
+        rows.append((cells[0], int(cells[1]), r, _number(cells[6])))
     return rows
+
+
+def _number(cell: str) -> float:
+    """A table cell's number; NaN (a gap in the plot) for one not measured, "–"."""
+    return math.nan if cell in ("–", "-") else float(cell)
 
 
 def gallery(names: list[str], size: int, frames: int) -> None:
