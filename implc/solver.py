@@ -91,10 +91,8 @@ class Solver:
     # Descartes' rule of signs), by degree: see BERNSTEIN_FROM
     strategy: str = "levels"
     # bernstein: the lets (name, printed value, pairs closed) that give b0..bn, the
-    # Bernstein coefficients of sum e_k w^k on w in [-1, 1] (see bernstein_lets), and the
-    # depth of a leaf node
+    # Bernstein coefficients of sum e_k w^k on w in [-1, 1] (see bernstein_lets)
     bernstein: tuple[tuple[str, str, tuple[int, ...]], ...] = ()
-    depth: int = 0
     # bernstein: w_i = -1 + 2i/n (printed), where b_i sits in the node's control polygon,
     # whose zero starts the Newton (see lower_solver), and 2/n, their spacing
     control_w: tuple[str, ...] = ()
@@ -181,8 +179,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         control_w = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
         robust_newton = n < ROBUST_NEWTON_BELOW
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
-                        BERNSTEIN_DEPTH, control_w, printer.float_literal(2 / n),
-                        robust_newton)
+                        control_w, printer.float_literal(2 / n), robust_newton)
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
