@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 from .errors import ToolError
+from .interrupts import signals_held
 from .resources import data_dir
 
 # --------------------------------------------------------------------------- OpenCL
@@ -44,7 +45,8 @@ class Device:
 
 def import_pyopencl():
     try:
-        import pyopencl
+        with signals_held():  # a nanobind module: a signal inside its import aborts
+            import pyopencl
     except ImportError as err:  # pragma: no cover - depends on the install
         raise ToolError("pyopencl is not installed (run `make setup`)") from err
     return pyopencl

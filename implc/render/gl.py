@@ -7,40 +7,20 @@ Rows are flipped on readback so row 0 is the top of the image, like every runner
 from __future__ import annotations
 
 import os
-import signal
-from collections.abc import Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Mapping, Sequence
 from functools import lru_cache
 
 import numpy as np
 
 from ..emit import ParamUniform, emit, param_uniforms, render_template
 from ..errors import ToolError
+from ..interrupts import signals_held
 from ..methods import Constants
 from ..scene import View
 from ..surface import Surface
 from .result import RenderResult, TimedRunner
 
 TRIANGLES = 0x0004  # GL_TRIANGLES
-
-
-@contextmanager
-def signals_held() -> Iterator[None]:
-    """SIGINT and SIGTERM wait, blocked in this thread, while the driver works: a Ctrl-C
-    that landed inside Mesa's shader compile (moderngl's ctx.program) segfaulted the
-    process (test_fault[gallery-SIGINT], about 1 run in 4 under load); Python raises it
-    as soon as the block ends. Threads the driver starts meanwhile (llvmpipe's) inherit
-    the block, so the signal is always taken by this thread."""
-    held = {signal.SIGINT, signal.SIGTERM}
-    try:
-        before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    except (AttributeError, ValueError, OSError):  # no pthreads
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 @lru_cache(maxsize=1)

@@ -14,11 +14,14 @@ import json
 from pathlib import Path
 
 import numpy as np
-import OpenImageIO as oiio
 
 from ..errors import OutputError
 from ..fileio import prepare_with
+from ..interrupts import signals_held
 from .result import RenderResult
+
+with signals_held():  # a nanobind module: a signal inside its import aborts the process
+    import OpenImageIO as oiio
 
 EXR_CHANNELS = ("R", "G", "B", "A", "Z", "steps")
 

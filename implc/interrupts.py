@@ -1,0 +1,63 @@
+"""Holding SIGINT and SIGTERM while native code works that a signal would break.
+
+A Ctrl-C or SIGTERM normally ends implc cleanly (KeyboardInterrupt, cli.Terminated). Two
+places cannot take one: Mesa's shader compile (a system call it interrupted is not
+retried: moderngl's ctx.program segfaulted, test_fault[gallery-SIGINT], about 1 run in 4
+under load) and the import of a nanobind extension (OpenImageIO, pyopencl: an exception
+raised while its module initialises aborts the process with "Critical nanobind error",
+test_fault[render-SIGTERM] under a second test run). Inside `signals_held()` both
+signals wait, and the one that came is acted on as the block ends.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+HELD = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM wait until the block ends.
+
+    Blocked in this thread (the C library is not interrupted; threads it starts inherit
+    the mask) and deferred at Python's level (a signal another thread took, such as one of
+    OpenBLAS's, would otherwise raise in the middle of the block's Python code). Off the
+    main thread, where Python cannot set handlers, only the mask applies."""
+    pending: list[int] = []
+
+    def defer(signum, frame) -> None:
+        pending.append(signum)
+
+    previous = {}
+    for sig in HELD:
+        if signal.getsignal(sig) is None:  # set from C: left as it is
+            continue
+        with contextlib.suppress(ValueError, OSError):  # not the main thread
+            previous[sig] = signal.signal(sig, defer)
+    try:
+        before = signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
+    except (AttributeError, ValueError, OSError):  # no pthreads
+        before = None
+    try:
+        yield
+    finally:
+        if before is not None:
+            # a signal that waited in the mask is delivered here, to `defer`
+            signal.pthread_sigmask(signal.SIG_SETMASK, before)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if pending:
+            _act_on(pending[0], previous.get(pending[0]))
+
+
+def _act_on(sig: int, handler) -> None:
+    """Do what the signal would have done outside the block."""
+    if callable(handler):
+        handler(sig, None)  # KeyboardInterrupt, Terminated, or a block around this one
+    elif handler == signal.SIG_DFL:
+        os.kill(os.getpid(), sig)
