@@ -6,11 +6,16 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
+import sys
 import threading
+from pathlib import Path
 
 import pytest
 
 from implc.interrupts import signals_held
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 class Stop(BaseException):
@@ -76,3 +81,21 @@ def test_nested_blocks_hand_the_signal_out_once():
         finished.append("outer")
     assert finished == ["inner", "outer"]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_python_m_implc_exits_with_its_code_after_a_caught_interrupt(tmp_path):
+    """A KeyboardInterrupt that escaped an exec() of a string (as one does when Ctrl-C
+    lands while a dataclass is being defined in a lazy import) made `python -m implc` die
+    by SIGINT (-2) although main() caught it and returned 130."""
+    (tmp_path / "interrupted_in_exec.py").write_text(
+        "import runpy, sys\n"
+        "import implc.cli\n"
+        "def interrupted(args):\n"
+        "    exec('raise KeyboardInterrupt')\n"
+        "implc.cli.cmd_list = interrupted\n"
+        "sys.argv = ['implc', 'list']\n"
+        "runpy.run_module('implc', run_name='__main__')\n")
+    proc = subprocess.run([sys.executable, "-m", "interrupted_in_exec"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert (proc.returncode, proc.stderr) == (130, "implc: interrupted\n")
