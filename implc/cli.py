@@ -834,7 +834,7 @@ def cmd_compile(args) -> int:
     args.target = target = _compile_target(args)
     _check_shader_options(args, TARGETS[target])
     if args.output:
-        check_output(args.output, shader_extensions(target), what=f"a {target} shader")
+        check_output(args.output, shader_extensions(target), what=f"the {target} shader")
     from .emit import emit
 
     surface = _surface(args)

@@ -137,25 +137,30 @@ def ray_name(quantities: tuple[str, ...]) -> str:
     return "ray_" + function_name(quantities)
 
 
-def ray_setup(coefficients: Program, printer) -> tuple[tuple, PrintedBody]:
+def ray_setup(coefficients: Program, printer, size: bool = True) -> tuple[tuple, PrintedBody]:
     """The ray record's fields and ray_of's body. The polynomial is expanded about the
     middle of the march interval: the record's origin is o = ro + sm rd and
     F(s) = S(o + s d) = sum c_k s^k, so |s| is at most hr, half the chord): about the
     entry point its terms would be up to 3^n times larger
     for the same sum, and float32 Horner loses that much more to cancellation. `size`,
     sum |c_k| hr^k, bounds the terms of F on the interval: the unit of the rounding
-    error in the exact solver's F. Storing the coefficients of F' and F'' as well
+    error in the level solver's F (the Bernstein walk's F is S at the point: no `size`
+    field). Storing the coefficients of F' and F'' as well
     measured slower on llvmpipe (a larger record, the same loop-invariant products)."""
     n = len(coefficients.outputs) - 1
     lets = [("real", v.name, f"oc.{c}") for v, c in zip(POINT, COMPONENT, strict=True)]
     lets += [("real", v.name, f"rd.{c}") for v, c in zip(DIRECTION, COMPONENT, strict=True)]
     lets += [("real", s.name, printer.doprint(v)) for s, v in coefficients.assignments]
     lets += [("real", f"c{k}", printer.doprint(o)) for k, o in enumerate(coefficients.outputs)]
-    size = horner([sympy.Abs(sym(f"c{k}")) for k in range(n + 1)], sym("hr"))
-    lets.append(("real", "size", printer.doprint(size)))
-    fields = (("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"),)
-    fields += tuple(("real", f"c{k}", f"coefficient of u^{k}") for k in range(n + 1))
-    return fields, PrintedBody(tuple(lets), ("size", *(f"c{k}" for k in range(n + 1))))
+    fields = tuple(("real", f"c{k}", f"coefficient of u^{k}") for k in range(n + 1))
+    values = tuple(f"c{k}" for k in range(n + 1))
+    if size:
+        bound = horner([sympy.Abs(sym(f"c{k}")) for k in range(n + 1)], sym("hr"))
+        lets.append(("real", "size", printer.doprint(bound)))
+        fields = (("real", "size", "sum |c_k| hr^k: the size of F's terms on the interval"),
+                  *fields)
+        values = ("size", *values)
+    return fields, PrintedBody(tuple(lets), values)
 
 
 def from_ray(carried: tuple[tuple[str, str], ...]) -> list[str]:

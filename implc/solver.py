@@ -112,11 +112,15 @@ def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
 
 
 def _value_function(name: str, n: int, printer, prefix: str,
-                    carried: tuple[tuple[str, str], ...]) -> ShaderFunction:
-    """F at u = t - sm, by Estrin's scheme where its sign is certain (ROUND_ERR), else S at
-    the point (see RAY_DERIVATIVES). Estrin's chain is about 2 log2(n) operations where
-    Horner's is 2n: measured on x^18 + y^18 + z^18 = 1 at 512^2 (with Fh), 8 % a frame."""
+                    carried: tuple[tuple[str, str], ...], certain_first: bool) -> ShaderFunction:
+    """F at u = t - sm, whose sign is the answer: S at the point, or (certain_first)
+    Estrin's value where its sign is certain (ROUND_ERR), else S at the point (see
+    RAY_DERIVATIVES). Estrin's chain is about 2 log2(n) operations where Horner's is 2n:
+    measured on x^18 + y^18 + z^18 = 1 at 512^2 (with Fh), 8 % a frame."""
     at_point = f"{prefix}S({', '.join(['ray.o + u*ray.d', *from_ray(carried)])})"
+    if not certain_first:
+        return ShaderFunction(name, "F at u = t - sm: S at the point",
+                              (("Ray", "ray"), ("real", "u")), "real", (), (at_point,))
     certain = f"{printer.doprint(sympy.Abs(sym('h')))} > {prefix.upper()}ROUND_ERR*ray.size"
     value, powers = estrin(derivative_coefficients(n, 0), sym("u"))
     return ShaderFunction(
@@ -138,9 +142,9 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                  for name, program in programs.items()]
     coefficients = coefficient_program(expr)
     n = len(coefficients.outputs) - 1
-    ray_fields, ray = carry(carried, *ray_setup(coefficients, printer))
     u = sym("u")
     bernstein = n >= BERNSTEIN_FROM
+    ray_fields, ray = carry(carried, *ray_setup(coefficients, printer, size=not bernstein))
     # P_k = F^(n-k): the derivatives, which only place the pieces (level by level), or F'
     # alone (Bernstein subdivision's Newton needs no other)
     for k in ((n - 1,) if bernstein else range(1, n)):
@@ -151,9 +155,16 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
             f"P{k}", f"P{k} = {what}, degree {k} in u = t - sm",
             (("Ray", "ray"), ("real", "u")), "real", tuple(printed_lets(powers, printer)),
             (printer.doprint(value),)))
-    # F itself, whose sign is the answer: Estrin where that sign is certain, else at the
-    # point (see RAY_DERIVATIVES)
-    functions.append(_value_function(f"P{n}", n, printer, prefix, carried))
+    # F itself, whose sign is the answer: for the levels, Estrin where that sign is certain,
+    # else at the point (see RAY_DERIVATIVES); for the Bernstein walk, at the point alone.
+    # llvmpipe computes both sides of the select (as does a SIMD group with lanes on both),
+    # so there Estrin's value only added its operations to every node's end: measured at
+    # 512^2, exact / taylor 2-10 % lower (x^18 sums 0.73 -> 0.68, Chmutov T18 1.24 ->
+    # 1.11, T12 0.72 -> 0.71, corpus rows 137 0.44 -> 0.41 and 244 0.57 -> 0.54), and the
+    # same false / missed / wrong-root counts on T12, x^12 sums and rows 137, 163, 244,
+    # 247 and 285 (docs/RESULTS.md section 8)
+    functions.append(_value_function(f"P{n}", n, printer, prefix, carried,
+                                     certain_first=not bernstein))
     c = [sym(f"ray.c{k}") for k in range(n + 1)]
     functions.append(ShaderFunction(
         "scale_at", "sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit "
@@ -161,7 +172,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         (), (printer.doprint(horner([sympy.Abs(ck) for ck in c], sympy.Abs(u))),)))
     K = prefix.upper()
     printed = (("real", K + "TOUCH", printer.float_literal(constants.touch)),
-               _round_err(n, printer, prefix),
+               *(() if bernstein else (_round_err(n, printer, prefix),)),
                ("real", K + "XTOL", printer.float_literal(constants.xtol)),
                ("real", K + "CTOL", printer.float_literal(constants.ctol)),
                ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))),

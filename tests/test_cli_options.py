@@ -220,7 +220,7 @@ def test_compile_takes_the_target_from_the_output_extension(tmp_path):
     # -t given: the extension must be its language's
     proc = implc("compile", "sphere", "-t", "glsl", "-o", str(tmp_path / "x.wgsl"))
     assert proc.returncode == 1
-    assert "a glsl shader needs .frag or .glsl, not '.wgsl'" in proc.stderr
+    assert "the glsl shader needs .frag or .glsl, not '.wgsl'" in proc.stderr
 
 
 def test_prefixes_other_targets_allow_are_accepted():
