@@ -23,6 +23,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 from .errors import InputError, OutputError
+from .interrupts import signals_held
 
 
 def read_input(path: Path, kind: str) -> bytes:
@@ -138,11 +139,21 @@ def prepare_with(path: Path, writer: Callable[[str], object]) -> Callable[[], No
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
         raise OutputError(f"cannot write {path}: directory {directory} does not exist")
+    made = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=directory)
+        # a signal between the file's making and the try below would leave it behind
+        # (test_fault[gallery-SIGTERM] under load): it waits until the name is held
+        with signals_held():
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix,
+                                       dir=directory)
+            os.close(fd)
+            made = tmp
     except OSError as err:
         raise OutputError(f"cannot write {path}: {_describe(err)}") from None
-    os.close(fd)
+    except BaseException:
+        if made is not None:  # the signal that waited
+            _unlink(made)
+        raise
     try:
         writer(tmp)
         umask = os.umask(0)
@@ -185,10 +196,19 @@ def staged_directory(out_dir: Path | str) -> Iterator[Path]:
     out_dir = Path(out_dir)
     parent = out_dir.parent if str(out_dir.parent) else Path(".")
     parent.mkdir(parents=True, exist_ok=True)
+    made = None
     try:
-        stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=parent))
+        # a signal between the directory's making and the try below would leave it
+        # behind (test_fault[gallery-SIGTERM] under load): it waits until the name is held
+        with signals_held():
+            stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=parent))
+            made = stage
     except OSError as err:
         raise OutputError(f"cannot write {out_dir}: {_describe(err)}") from None
+    except BaseException:
+        if made is not None:  # the signal that waited
+            shutil.rmtree(made, ignore_errors=True)
+        raise
     try:
         try:
             yield stage

@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 from pathlib import Path
 
@@ -99,3 +100,34 @@ def test_python_m_implc_exits_with_its_code_after_a_caught_interrupt(tmp_path):
                           capture_output=True, text=True, timeout=120,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert (proc.returncode, proc.stderr) == (130, "implc: interrupted\n")
+
+
+def _interrupting(real):
+    """`real` (tempfile.mkdtemp or mkstemp), then a SIGINT to this process before the
+    name gets back to the caller: where the signal of a loaded machine can land."""
+
+    def made_then_interrupted(*args, **kwargs):
+        made = real(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGINT)
+        return made
+
+    return made_then_interrupted
+
+
+def test_an_interrupt_as_the_staging_directory_is_made_leaves_nothing(tmp_path, monkeypatch):
+    """test_fault[gallery-SIGTERM] left a `.out.partial-*` directory once under load."""
+    from implc.fileio import staged_directory
+
+    monkeypatch.setattr(tempfile, "mkdtemp", _interrupting(tempfile.mkdtemp))
+    with pytest.raises(KeyboardInterrupt), staged_directory(tmp_path / "out"):
+        pass
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_interrupt_as_a_temporary_file_is_made_leaves_nothing(tmp_path, monkeypatch):
+    from implc.fileio import write_atomic
+
+    monkeypatch.setattr(tempfile, "mkstemp", _interrupting(tempfile.mkstemp))
+    with pytest.raises(KeyboardInterrupt):
+        write_atomic(tmp_path / "out.txt", "text")
+    assert list(tmp_path.iterdir()) == []
