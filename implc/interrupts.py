@@ -1,12 +1,13 @@
-"""Holding SIGINT and SIGTERM while native code works that a signal would break.
+"""Holding SIGINT and SIGTERM where one would break things: native code, and files being made.
 
-A Ctrl-C or SIGTERM normally ends implc cleanly (KeyboardInterrupt, cli.Terminated). Two
+A Ctrl-C or SIGTERM normally ends implc cleanly (KeyboardInterrupt, cli.Terminated). Three
 places cannot take one: Mesa's shader compile (a system call it interrupted is not
 retried: moderngl's ctx.program segfaulted, test_fault[gallery-SIGINT], about 1 run in 4
-under load) and the import of a nanobind extension (OpenImageIO, pyopencl: an exception
+under load), the import of a nanobind extension (OpenImageIO, pyopencl: an exception
 raised while its module initialises aborts the process with "Critical nanobind error",
-test_fault[render-SIGTERM] under a second test run). Inside `signals_held()` both
-signals wait, and the one that came is acted on as the block ends.
+test_fault[render-SIGTERM] under a second test run), and the making of a temporary file
+or directory before its name reaches the code that removes it (implc.fileio). Inside
+`signals_held()` both signals wait, and the one that came is acted on as the block ends.
 """
 
 from __future__ import annotations
