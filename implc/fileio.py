@@ -21,9 +21,12 @@ import shutil
 import tempfile
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
+from typing import TypeVar
 
 from .errors import InputError, OutputError
 from .interrupts import signals_held
+
+T = TypeVar("T")
 
 
 def read_input(path: Path, kind: str) -> bytes:
@@ -139,21 +142,10 @@ def prepare_with(path: Path, writer: Callable[[str], object]) -> Callable[[], No
     directory = path.parent if str(path.parent) else Path(".")
     if not directory.is_dir():
         raise OutputError(f"cannot write {path}: directory {directory} does not exist")
-    made = None
     try:
-        # a signal between the file's making and the try below would leave it behind
-        # (test_fault[gallery-SIGTERM] under load): it waits until the name is held
-        with signals_held():
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix,
-                                       dir=directory)
-            os.close(fd)
-            made = tmp
+        tmp = _made_held(lambda: _temp_file(path, directory), _unlink)
     except OSError as err:
         raise OutputError(f"cannot write {path}: {_describe(err)}") from None
-    except BaseException:
-        if made is not None:  # the signal that waited
-            _unlink(made)
-        raise
     try:
         writer(tmp)
         umask = os.umask(0)
@@ -182,6 +174,27 @@ def prepare_with(path: Path, writer: Callable[[str], object]) -> Callable[[], No
     return commit
 
 
+def _made_held(make: Callable[[], T], remove: Callable[[T], object]) -> T:
+    """make() (a temporary file or directory) with SIGINT and SIGTERM held: a signal
+    between its making and the caller's cleanup would leave it behind
+    (test_fault[gallery-SIGTERM] under load). The signal that waited removes it."""
+    made = None
+    try:
+        with signals_held():
+            made = make()
+    except BaseException:
+        if made is not None:
+            remove(made)
+        raise
+    return made
+
+
+def _temp_file(path: Path, directory: Path) -> str:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=directory)
+    os.close(fd)
+    return tmp
+
+
 def _unlink(path: str) -> None:
     with contextlib.suppress(FileNotFoundError):
         os.unlink(path)
@@ -196,19 +209,12 @@ def staged_directory(out_dir: Path | str) -> Iterator[Path]:
     out_dir = Path(out_dir)
     parent = out_dir.parent if str(out_dir.parent) else Path(".")
     parent.mkdir(parents=True, exist_ok=True)
-    made = None
     try:
-        # a signal between the directory's making and the try below would leave it
-        # behind (test_fault[gallery-SIGTERM] under load): it waits until the name is held
-        with signals_held():
-            stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=parent))
-            made = stage
+        stage = _made_held(
+            lambda: Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=parent)),
+            lambda made: shutil.rmtree(made, ignore_errors=True))
     except OSError as err:
         raise OutputError(f"cannot write {out_dir}: {_describe(err)}") from None
-    except BaseException:
-        if made is not None:  # the signal that waited
-            shutil.rmtree(made, ignore_errors=True)
-        raise
     try:
         try:
             yield stage
