@@ -42,6 +42,7 @@ from .fileio import (
     read_input,
     write_atomic,
 )
+from .interrupts import Terminated, dropped_signals_kept, raise_dropped
 from .limits import Limits
 from .options import (
     AUTO_MAX_DEGREE,
@@ -134,10 +135,6 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message, self.prog)
 
 
-class Terminated(BaseException):
-    """SIGTERM, raised like KeyboardInterrupt so temporary files are cleaned up."""
-
-
 def _on_sigterm(signum, frame):
     raise Terminated()
 
@@ -161,11 +158,17 @@ def _install_signals() -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
+    with dropped_signals_kept():
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     previous = _install_signals()
     command = "implc"
     stdout = sys.stdout
     sys.stdout = _GuardedStdout(stdout)
     try:
+        raise_dropped()  # one that came while the modules loaded
         parser = build_parser()
         args = parser.parse_args(_join_equation_values(sys.argv[1:] if argv is None else argv))
         command = getattr(args, "command", None) or "implc"
@@ -179,6 +182,7 @@ def main(argv: list[str] | None = None) -> int:
         _NOTES.clear()
         with derive_limits(getattr(args, "max_derived", None)):
             code = args.run(args)
+        raise_dropped()
         _print_notes()  # what framing chose, once the command has done its work
         sys.stdout.flush()  # a full disk under `> file` is reported here, not at exit
         return code

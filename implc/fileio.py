@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from .errors import InputError, OutputError
-from .interrupts import signals_held
+from .interrupts import raise_dropped, signals_held
 
 T = TypeVar("T")
 
@@ -148,6 +148,7 @@ def prepare_with(path: Path, writer: Callable[[str], object]) -> Callable[[], No
         raise OutputError(f"cannot write {path}: {_describe(err)}") from None
     try:
         writer(tmp)
+        raise_dropped()  # an interrupted run puts no output in place
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; outputs are ordinary files
@@ -222,6 +223,7 @@ def staged_directory(out_dir: Path | str) -> Iterator[Path]:
             err.message = err.message.replace(str(stage), str(out_dir))
             err.args = (err.message,)
             raise
+        raise_dropped()
         if not out_dir.exists():
             os.chmod(stage, 0o777 & ~_umask())
             os.replace(stage, out_dir)

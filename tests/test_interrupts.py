@@ -1,6 +1,7 @@
-"""implc.interrupts.signals_held: a SIGINT or SIGTERM that comes inside the block is acted
-on as the block ends, not in its middle (where a nanobind import or Mesa's compile would
-abort), whichever thread the kernel gives it to."""
+"""implc.interrupts: a SIGINT or SIGTERM that comes inside `signals_held()` is acted on as
+the block ends, not in its middle (where a nanobind import or Mesa's compile would abort),
+whichever thread the kernel gives it to; one that Python drops (raised in a `__del__` or a
+weakref callback) still ends the run, and no output is put in place after it."""
 
 from __future__ import annotations
 
@@ -131,3 +132,66 @@ def test_an_interrupt_as_a_temporary_file_is_made_leaves_nothing(tmp_path, monke
     with pytest.raises(KeyboardInterrupt):
         write_atomic(tmp_path / "out.txt", "text")
     assert list(tmp_path.iterdir()) == []
+
+
+def _drop(kind: type[BaseException] = KeyboardInterrupt) -> None:
+    """`kind` raised where Python drops it: in a `__del__` (like a weakref callback or a
+    garbage-collector run, where Ctrl-C landed in test_fault[bench-SIGINT])."""
+
+    class RaisesWhenCollected:
+        def __del__(self):
+            raise kind()
+
+    RaisesWhenCollected()
+
+
+def test_a_dropped_signal_is_kept_silently_and_raised_again(capsys):
+    from implc.interrupts import Terminated, dropped_signals_kept, raise_dropped
+
+    for kind in (KeyboardInterrupt, Terminated):
+        with dropped_signals_kept():
+            _drop(kind)
+            with pytest.raises(kind):
+                raise_dropped()
+            raise_dropped()  # once
+    assert capsys.readouterr().err == ""
+
+
+def test_an_output_is_not_put_in_place_after_a_dropped_interrupt(tmp_path):
+    from implc.fileio import staged_directory, write_with
+    from implc.interrupts import dropped_signals_kept
+
+    def writer(tmp: str) -> None:
+        Path(tmp).write_text("complete")
+        _drop()
+
+    with dropped_signals_kept():
+        with pytest.raises(KeyboardInterrupt):
+            write_with(tmp_path / "out.txt", writer)
+        with pytest.raises(KeyboardInterrupt), staged_directory(tmp_path / "run") as stage:
+            writer(str(stage / "table.md"))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_implc_exits_interrupted_after_a_dropped_interrupt(tmp_path):
+    """Ctrl-C in importlib's module-lock callback was dropped by Python, and `implc bench`
+    finished and exited 0 (test_fault[bench-SIGINT] in CI)."""
+    (tmp_path / "dropped_interrupt.py").write_text(
+        "import runpy, signal, sys, os\n"
+        "import implc.cli\n"
+        "class InterruptedWhenCollected:\n"
+        "    def __del__(self):\n"
+        "        os.kill(os.getpid(), signal.SIGINT)\n"
+        "        sum(range(100000))  # the handler raises here, inside __del__\n"
+        "def listed(args):\n"
+        "    InterruptedWhenCollected()\n"
+        "    print('listed')\n"
+        "    return 0\n"
+        "implc.cli.cmd_list = listed\n"
+        "sys.argv = ['implc', 'list']\n"
+        "runpy.run_module('implc', run_name='__main__')\n")
+    proc = subprocess.run([sys.executable, "-m", "dropped_interrupt"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)},
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    assert (proc.returncode, proc.stderr) == (130, "implc: interrupted\n")
