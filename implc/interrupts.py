@@ -100,6 +100,7 @@ def dropped_signals_kept() -> Iterator[None]:
         yield
     finally:
         sys.unraisablehook = previous
+        _dropped.clear()  # not carried into a later run in the same process (tests)
 
 
 def raise_dropped() -> None:
