@@ -204,7 +204,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
     if form == "ray-poly":
         coefficients = coefficient_program(expr)
         n = len(coefficients.outputs) - 1
-        fields, ray = ray_setup(coefficients, printer)
+        fields, ray = ray_setup(coefficients, printer, size=False)
         functions += [estrin_function(q, n, printer) for kind, q in wanted if kind == "ray"]
     ray_fields, ray = carry(carried, fields, ray)
     by_name = {f.name: f for f in functions}

@@ -137,15 +137,15 @@ def ray_name(quantities: tuple[str, ...]) -> str:
     return "ray_" + function_name(quantities)
 
 
-def ray_setup(coefficients: Program, printer, size: bool = True) -> tuple[tuple, PrintedBody]:
+def ray_setup(coefficients: Program, printer, size: bool) -> tuple[tuple, PrintedBody]:
     """The ray record's fields and ray_of's body. The polynomial is expanded about the
     middle of the march interval: the record's origin is o = ro + sm rd and
     F(s) = S(o + s d) = sum c_k s^k, so |s| is at most hr, half the chord): about the
     entry point its terms would be up to 3^n times larger
     for the same sum, and float32 Horner loses that much more to cancellation. `size`,
     sum |c_k| hr^k, bounds the terms of F on the interval: the unit of the rounding
-    error in the level solver's F (the Bernstein walk's F is S at the point: no `size`
-    field). Storing the coefficients of F' and F'' as well
+    error in the level solver's F, and only there (the Bernstein walk's F is S at the
+    point, and the marchers read no bound: no `size` field). Storing the coefficients of F' and F'' as well
     measured slower on llvmpipe (a larger record, the same loop-invariant products)."""
     n = len(coefficients.outputs) - 1
     lets = [("real", v.name, f"oc.{c}") for v, c in zip(POINT, COMPONENT, strict=True)]

@@ -17,7 +17,6 @@ struct Ray {
     vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -117,8 +116,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float c1 = ((t14*z + (-t10*x + (54.0*dz*x*y + 126.0*dz*y))) + ((-t6*y - t6*z) + (-t9*z + (-18.0*t3 - 18.0*t4)))) + ((((243.0*dx*x_2 - t7*t8) + (243.0*dy*y_2 + 243.0*dz*z_2)) + (((-9.0*dx - 9.0*dy) + (126.0*dx*y - 9.0*dz)) + ((126.0*dx*z + 126.0*dy*x) + (126.0*dy*z + 126.0*dz*x)))) + (((-t11*y_2 - 18.0*t5) + (-t11*z_2 - t12*x_2)) + ((-t12*z_2 - t13*x_2) + (-t13*y_2 - t5*t8))));
     float c2 = ((dz*t14 + (243.0*dz_2*z + (126.0*dx*dy + 126.0*dx*dz))) + ((-dx*t10 + (54.0*dx*dy*z + 126.0*dy*dz)) + (-dx*t9 - dy*t10))) + (((-dz*t6 - dz*t9) + ((-9.0*dx_2 - 9.0*dy_2) + (-dx_2*t1 - 9.0*dz_2))) + (((-378.0*dx*t7 - dz_2*t1) + (243.0*dx_2*x + 243.0*dy_2*y)) + ((-dx_2*t2 - dy_2*t0) + (-dy_2*t2 - dz_2*t0))));
     float c3 = ((81.0*dx_3 - dz_2*t12) + (-dy_2*t13 - dz_2*t11)) + ((81.0*dy_3 + 81.0*dz_3) + ((-dx_2*t13 - dy_2*t11) + (54.0*dx*dy*dz - dx_2*t12)));
-    float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2, c3);
+    return Ray(oc, rd, sm, c0, c1, c2, c3);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -17,7 +17,6 @@ struct Ray {
     vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -87,8 +86,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float c1 = -dz*t0*t1 + (dz*z_2 + (2.0*dx*x + 2.0*dy*y));
     float c2 = -dz_2*t0 + (dz_2*t1 + (dx_2 + dy_2));
     float c3 = dz_3;
-    float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2, c3);
+    return Ray(oc, rd, sm, c0, c1, c2, c3);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -29,7 +29,6 @@ struct Ray {
     vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -138,8 +137,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float c4 = t13*t14 + (2.0*t13*t9_2 + (t1*t13_2 + ((-dz_3*t3 - dz_3*t5) + (-t12*t16 - t12*t17))));
     float c5 = 3.0*t13_2*t9 + (-dx_2*dz_3 - dy_2*t15);
     float c6 = t13_3;
-    float size = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);
+    return Ray(oc, rd, sm, c0, c1, c2, c3, c4, c5, c6);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

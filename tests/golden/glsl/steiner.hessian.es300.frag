@@ -32,7 +32,6 @@ struct Ray {
     vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -118,8 +117,7 @@ Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
     float c2 = (dz*t9 + (-t1*t11 + t11*t5)) + (((dx_2*y_2 + dy_2*x_2) + (dy_2*z_2 + dz_2*y_2)) + ((-dx_2*z_2 - dz_2*x_2) + (-t10*z + 4.0*t7*t8)));
     float c3 = (-t13*t6 + (2.0*dy_2*t6 - dz*t10)) + ((dy_2*t12 + 2.0*dz_2*t5) + (-dz_2*t12 + t13*t5));
     float c4 = -dx_2*dz_2 + (dx_2*dy_2 + dy_2*dz_2);
-    float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray(oc, rd, sm, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

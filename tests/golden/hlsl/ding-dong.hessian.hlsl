@@ -34,19 +34,17 @@ struct Ray {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
     float c3;  // coefficient of u^3
 };
 
-Ray Ray_new(float3 o, float3 d, float sm, float size, float c0, float c1, float c2, float c3) {
+Ray Ray_new(float3 o, float3 d, float sm, float c0, float c1, float c2, float c3) {
     Ray r;
     r.o = o;
     r.d = d;
     r.sm = sm;
-    r.size = size;
     r.c0 = c0;
     r.c1 = c1;
     r.c2 = c2;
@@ -125,8 +123,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c1 = -dz*t0*t1 + (dz*z_2 + (2.0*dx*x + 2.0*dy*y));
     float c2 = -dz_2*t0 + (dz_2*t1 + (dx_2 + dy_2));
     float c3 = dz_3;
-    float size = hr*(hr*(hr*abs(c3) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray_new(oc, rd, sm, size, c0, c1, c2, c3);
+    return Ray_new(oc, rd, sm, c0, c1, c2, c3);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -34,7 +34,6 @@ struct Ray {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -44,12 +43,11 @@ struct Ray {
     float c6;  // coefficient of u^6
 };
 
-Ray Ray_new(float3 o, float3 d, float sm, float size, float c0, float c1, float c2, float c3, float c4, float c5, float c6) {
+Ray Ray_new(float3 o, float3 d, float sm, float c0, float c1, float c2, float c3, float c4, float c5, float c6) {
     Ray r;
     r.o = o;
     r.d = d;
     r.sm = sm;
-    r.size = size;
     r.c0 = c0;
     r.c1 = c1;
     r.c2 = c2;
@@ -167,8 +165,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c4 = t13*t14 + (2.0*t13*t9_2 + (t1*t13_2 + ((-dz_3*t3 - dz_3*t5) + (-t12*t16 - t12*t17))));
     float c5 = 3.0*t13_2*t9 + (-dx_2*dz_3 - dy_2*t15);
     float c6 = t13_3;
-    float size = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray_new(oc, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);
+    return Ray_new(oc, rd, sm, c0, c1, c2, c3, c4, c5, c6);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -34,7 +34,6 @@ struct Ray {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -42,12 +41,11 @@ struct Ray {
     float c4;  // coefficient of u^4
 };
 
-Ray Ray_new(float3 o, float3 d, float sm, float size, float c0, float c1, float c2, float c3, float c4) {
+Ray Ray_new(float3 o, float3 d, float sm, float c0, float c1, float c2, float c3, float c4) {
     Ray r;
     r.o = o;
     r.d = d;
     r.sm = sm;
-    r.size = size;
     r.c0 = c0;
     r.c1 = c1;
     r.c2 = c2;
@@ -145,8 +143,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c2 = (dz*t9 + (t11*t2 + t11*t4)) + (((dx_2*y_2 + dx_2*z_2) + (dy_2*x_2 + dy_2*z_2)) + ((dz_2*x_2 + dz_2*y_2) + (-t10*z + 4.0*t7*t8)));
     float c3 = (dz_2*t13 + (dx_2*t13 - dz*t10)) + ((dx_2*t14 + dy_2*t12) + (dy_2*t14 + dz_2*t12));
     float c4 = dy_2*dz_2 + (dx_2*dy_2 + dx_2*dz_2);
-    float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray_new(oc, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray_new(oc, rd, sm, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -34,18 +34,16 @@ struct Ray {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
 };
 
-Ray Ray_new(float3 o, float3 d, float sm, float size, float c0, float c1, float c2) {
+Ray Ray_new(float3 o, float3 d, float sm, float c0, float c1, float c2) {
     Ray r;
     r.o = o;
     r.d = d;
     r.sm = sm;
-    r.size = size;
     r.c0 = c0;
     r.c1 = c1;
     r.c2 = c2;
@@ -116,8 +114,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c0 = (x_2 - 1.0) + (y_2 + z_2);
     float c1 = 2.0*dz*z + (2.0*dx*x + 2.0*dy*y);
     float c2 = dz_2 + (dx_2 + dy_2);
-    float size = hr*(hr*abs(c2) + abs(c1)) + abs(c0);
-    return Ray_new(oc, rd, sm, size, c0, c1, c2);
+    return Ray_new(oc, rd, sm, c0, c1, c2);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -34,7 +34,6 @@ struct Ray {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -42,12 +41,11 @@ struct Ray {
     float c4;  // coefficient of u^4
 };
 
-Ray Ray_new(float3 o, float3 d, float sm, float size, float c0, float c1, float c2, float c3, float c4) {
+Ray Ray_new(float3 o, float3 d, float sm, float c0, float c1, float c2, float c3, float c4) {
     Ray r;
     r.o = o;
     r.d = d;
     r.sm = sm;
-    r.size = size;
     r.c0 = c0;
     r.c1 = c1;
     r.c2 = c2;
@@ -145,8 +143,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c2 = (6.0*dy_2*y_2 + 6.0*dz_2*z_2) + ((-dx_2 - dy_2) + (6.0*dx_2*x_2 - dz_2));
     float c3 = 4.0*dz_3*z + (4.0*dx_3*x + 4.0*dy_3*y);
     float c4 = dz_4 + (dx_4 + dy_4);
-    float size = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray_new(oc, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray_new(oc, rd, sm, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -30,7 +30,6 @@ typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -102,8 +101,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c1 = t3*z + (dz*t1 + (8.0f*dz*z + (8.0f*dx*x + 8.0f*dy*y)));
     float c2 = (4.0f*dz_2 + t4*z) + (dz*t3 + (4.0f*dx_2 + 4.0f*dy_2));
     float c3 = dz*t4;
-    float size = hr*(hr*(hr*fabs(c3) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){oc, rd, sm, size, c0, c1, c2, c3};
+    return (Ray){oc, rd, sm, c0, c1, c2, c3};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

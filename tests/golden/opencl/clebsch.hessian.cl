@@ -30,7 +30,6 @@ typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -130,8 +129,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c1 = ((t14*z + (-t10*x + (54.0f*dz*x*y + 126.0f*dz*y))) + ((-t6*y - t6*z) + (-t9*z + (-18.0f*t3 - 18.0f*t4)))) + ((((243.0f*dx*x_2 - t7*t8) + (243.0f*dy*y_2 + 243.0f*dz*z_2)) + (((-9.0f*dx - 9.0f*dy) + (126.0f*dx*y - 9.0f*dz)) + ((126.0f*dx*z + 126.0f*dy*x) + (126.0f*dy*z + 126.0f*dz*x)))) + (((-t11*y_2 - 18.0f*t5) + (-t11*z_2 - t12*x_2)) + ((-t12*z_2 - t13*x_2) + (-t13*y_2 - t5*t8))));
     float c2 = ((dz*t14 + (243.0f*dz_2*z + (126.0f*dx*dy + 126.0f*dx*dz))) + ((-dx*t10 + (54.0f*dx*dy*z + 126.0f*dy*dz)) + (-dx*t9 - dy*t10))) + (((-dz*t6 - dz*t9) + ((-9.0f*dx_2 - 9.0f*dy_2) + (-dx_2*t1 - 9.0f*dz_2))) + (((-378.0f*dx*t7 - dz_2*t1) + (243.0f*dx_2*x + 243.0f*dy_2*y)) + ((-dx_2*t2 - dy_2*t0) + (-dy_2*t2 - dz_2*t0))));
     float c3 = ((81.0f*dx_3 - dz_2*t12) + (-dy_2*t13 - dz_2*t11)) + ((81.0f*dy_3 + 81.0f*dz_3) + ((-dx_2*t13 - dy_2*t11) + (54.0f*dx*dy*dz - dx_2*t12)));
-    float size = hr*(hr*(hr*fabs(c3) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){oc, rd, sm, size, c0, c1, c2, c3};
+    return (Ray){oc, rd, sm, c0, c1, c2, c3};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -30,7 +30,6 @@ typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -118,8 +117,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c2 = (t11*t2 + (t4*t5 + t9*y_2)) + (t7*t8 + (dy_2*t1 + t10*t3));
     float c3 = t11*t8 + (t10*t7 + (dy_2*t5 + t4*t9));
     float c4 = dy_2*t9 + t10*t11;
-    float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
+    return (Ray){oc, rd, sm, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -31,7 +31,6 @@ typedef struct {
     double3 o;  // origin of the march, s = 0: the point ro + sm rd
     double3 d;  // unit direction
     double sm;  // where o lies on the caller's ray: t = sm + s
-    double size;  // sum |c_k| hr^k: the size of F's terms on the interval
     double c0;  // coefficient of u^0
     double c1;  // coefficient of u^1
     double c2;  // coefficient of u^2
@@ -119,8 +118,7 @@ Ray ray_of(double3 ro, double3 rd, double sm, double hr) {
     double c2 = (t11*t2 + (t4*t5 + t9*y_2)) + (t7*t8 + (dy_2*t1 + t10*t3));
     double c3 = t11*t8 + (t10*t7 + (dy_2*t5 + t4*t9));
     double c4 = dy_2*t9 + t10*t11;
-    double size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
+    return (Ray){oc, rd, sm, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

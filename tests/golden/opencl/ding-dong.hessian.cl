@@ -30,7 +30,6 @@ typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -100,8 +99,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c1 = -dz*t0*t1 + (dz*z_2 + (2.0f*dx*x + 2.0f*dy*y));
     float c2 = -dz_2*t0 + (dz_2*t1 + (dx_2 + dy_2));
     float c3 = dz_3;
-    float size = hr*(hr*(hr*fabs(c3) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){oc, rd, sm, size, c0, c1, c2, c3};
+    return (Ray){oc, rd, sm, c0, c1, c2, c3};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

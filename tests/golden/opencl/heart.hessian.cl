@@ -30,7 +30,6 @@ typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -139,8 +138,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c4 = t13*t14 + (2.0f*t13*t9_2 + (t1*t13_2 + ((-dz_3*t3 - dz_3*t5) + (-t12*t16 - t12*t17))));
     float c5 = 3.0f*t13_2*t9 + (-dx_2*dz_3 - dy_2*t15);
     float c6 = t13_3;
-    float size = hr*(hr*(hr*(hr*(hr*(hr*fabs(c6) + fabs(c5)) + fabs(c4)) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4, c5, c6};
+    return (Ray){oc, rd, sm, c0, c1, c2, c3, c4, c5, c6};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -30,7 +30,6 @@ typedef struct {
     float3 o;  // origin of the march, s = 0: the point ro + sm rd
     float3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
-    float size;  // sum |c_k| hr^k: the size of F's terms on the interval
     float c0;  // coefficient of u^0
     float c1;  // coefficient of u^1
     float c2;  // coefficient of u^2
@@ -114,8 +113,7 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
     float c2 = (-dy_2*t3 - t4*t6) + ((t1*t10 + t12*t2) + (-t13*y_2 + t8*t9));
     float c3 = (-dy_2*t6 - t13*t4) + (t10*t9 + t12*t8);
     float c4 = -dy_2*t13 + t10*t12;
-    float size = hr*(hr*(hr*(hr*fabs(c4) + fabs(c3)) + fabs(c2)) + fabs(c1)) + fabs(c0);
-    return (Ray){oc, rd, sm, size, c0, c1, c2, c3, c4};
+    return (Ray){oc, rd, sm, c0, c1, c2, c3, c4};
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

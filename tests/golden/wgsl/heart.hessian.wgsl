@@ -39,7 +39,6 @@ struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
     sm: f32,  // where o lies on the caller's ray: t = sm + s
-    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
     c0: f32,  // coefficient of u^0
     c1: f32,  // coefficient of u^1
     c2: f32,  // coefficient of u^2
@@ -148,8 +147,7 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let c4: f32 = t13*t14 + (2.0f*t13*t9_2 + (t1*t13_2 + ((-dz_3*t3 - dz_3*t5) + (-t12*t16 - t12*t17))));
     let c5: f32 = 3.0f*t13_2*t9 + (-dx_2*dz_3 - dy_2*t15);
     let c6: f32 = t13_3;
-    let size: f32 = hr*(hr*(hr*(hr*(hr*(hr*abs(c6) + abs(c5)) + abs(c4)) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4, c5, c6);
+    return Ray(oc, rd, sm, c0, c1, c2, c3, c4, c5, c6);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -39,7 +39,6 @@ struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
     sm: f32,  // where o lies on the caller's ray: t = sm + s
-    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
     c0: f32,  // coefficient of u^0
     c1: f32,  // coefficient of u^1
     c2: f32,  // coefficient of u^2
@@ -154,8 +153,7 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let c2: f32 = t2*t20 + (t11*t17 + (t18*t9 + t8_2));
     let c3: f32 = t11*t20 + (2.0f*t18*t8 + t2*t21);
     let c4: f32 = t11*t21 + t18_2;
-    let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray(oc, rd, sm, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

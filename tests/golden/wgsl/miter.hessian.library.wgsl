@@ -29,7 +29,6 @@ struct miter_Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
     sm: f32,  // where o lies on the caller's ray: t = sm + s
-    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
     c0: f32,  // coefficient of u^0
     c1: f32,  // coefficient of u^1
     c2: f32,  // coefficient of u^2
@@ -119,8 +118,7 @@ fn miter_ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> miter_Ray {
     let c2: f32 = (-dy_2*t3 - t4*t6) + ((t1*t10 + t12*t2) + (-t13*y_2 + t8*t9));
     let c3: f32 = (-dy_2*t6 - t13*t4) + (t10*t9 + t12*t8);
     let c4: f32 = -dy_2*t13 + t10*t12;
-    let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return miter_Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
+    return miter_Ray(oc, rd, sm, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

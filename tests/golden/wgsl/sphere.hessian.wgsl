@@ -39,7 +39,6 @@ struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
     sm: f32,  // where o lies on the caller's ray: t = sm + s
-    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
     c0: f32,  // coefficient of u^0
     c1: f32,  // coefficient of u^1
     c2: f32,  // coefficient of u^2
@@ -101,8 +100,7 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let c0: f32 = (x_2 - 1.0f) + (y_2 + z_2);
     let c1: f32 = 2.0f*dz*z + (2.0f*dx*x + 2.0f*dy*y);
     let c2: f32 = dz_2 + (dx_2 + dy_2);
-    let size: f32 = hr*(hr*abs(c2) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2);
+    return Ray(oc, rd, sm, c0, c1, c2);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is

@@ -39,7 +39,6 @@ struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
     sm: f32,  // where o lies on the caller's ray: t = sm + s
-    size: f32,  // sum |c_k| hr^k: the size of F's terms on the interval
     c0: f32,  // coefficient of u^0
     c1: f32,  // coefficient of u^1
     c2: f32,  // coefficient of u^2
@@ -119,8 +118,7 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
     let c2: f32 = (dz*t9 + (-t1*t11 + t11*t5)) + (((dx_2*y_2 + dy_2*x_2) + (dy_2*z_2 + dz_2*y_2)) + ((-dx_2*z_2 - dz_2*x_2) + (-t10*z + 4.0f*t7*t8)));
     let c3: f32 = (-t13*t6 + (2.0f*dy_2*t6 - dz*t10)) + ((dy_2*t12 + 2.0f*dz_2*t5) + (-dz_2*t12 + t13*t5));
     let c4: f32 = -dx_2*dz_2 + (dx_2*dy_2 + dy_2*dz_2);
-    let size: f32 = hr*(hr*(hr*(hr*abs(c4) + abs(c3)) + abs(c2)) + abs(c1)) + abs(c0);
-    return Ray(oc, rd, sm, size, c0, c1, c2, c3, c4);
+    return Ray(oc, rd, sm, c0, c1, c2, c3, c4);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is
