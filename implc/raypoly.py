@@ -145,8 +145,9 @@ def ray_setup(coefficients: Program, printer, size: bool) -> tuple[tuple, Printe
     for the same sum, and float32 Horner loses that much more to cancellation. `size`,
     sum |c_k| hr^k, bounds the terms of F on the interval: the unit of the rounding
     error in the level solver's F, and only there (the Bernstein walk's F is S at the
-    point, and the marchers read no bound: no `size` field). Storing the coefficients of F' and F'' as well
-    measured slower on llvmpipe (a larger record, the same loop-invariant products)."""
+    point, and the marchers read no bound: no `size` field). Storing the coefficients of
+    F' and F'' as well measured slower on llvmpipe (a larger record, the same
+    loop-invariant products)."""
     n = len(coefficients.outputs) - 1
     lets = [("real", v.name, f"oc.{c}") for v, c in zip(POINT, COMPONENT, strict=True)]
     lets += [("real", v.name, f"rd.{c}") for v, c in zip(DIRECTION, COMPONENT, strict=True)]

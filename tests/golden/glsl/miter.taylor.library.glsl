@@ -13,7 +13,7 @@
 //   miter_Ray miter_ray_of(vec3 ro, vec3 rd, float sm, float hr)
 //       the ray record march/intersect use: o = ro + sm rd (the middle of [sm - hr, sm + hr]),
 //       d, sm, the ray polynomial's coefficients c0..cn of
-//       F(s) = S(o + s d) = sum c_k s^k and size = sum |c_k| hr^k.
+//       F(s) = S(o + s d) = sum c_k s^k.
 // rd must be unit length; t is measured along rd from ro.
 
 // Method constants (implc compile options).

@@ -15,7 +15,7 @@
 //   cross_cap_Ray cross_cap_ray_of(float3 ro, float3 rd, float sm, float hr)
 //       the ray record march/intersect use: o = ro + sm rd (the middle of [sm - hr, sm + hr]),
 //       d, sm, the ray polynomial's coefficients c0..cn of
-//       F(s) = S(o + s d) = sum c_k s^k and size = sum |c_k| hr^k.
+//       F(s) = S(o + s d) = sum c_k s^k.
 // rd must be unit length; t is measured along rd from ro; t and steps point to private
 // memory.
 

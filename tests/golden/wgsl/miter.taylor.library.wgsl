@@ -13,7 +13,7 @@
 //   fn miter_ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> miter_Ray
 //       the ray record march/intersect use: o = ro + sm rd (the middle of [sm - hr, sm + hr]),
 //       d, sm, the ray polynomial's coefficients c0..cn of
-//       F(s) = S(o + s d) = sum c_k s^k and size = sum |c_k| hr^k.
+//       F(s) = S(o + s d) = sum c_k s^k.
 // struct miter_Hit { hit: bool, t: f32, steps: i32 }: WGSL has no `out` parameters.
 // rd must be unit length; t is measured along rd from ro.
 
