@@ -1,6 +1,6 @@
 """Holding SIGINT and SIGTERM where one would break things: native code, and files being made.
 
-A Ctrl-C or SIGTERM normally ends implc cleanly (KeyboardInterrupt, cli.Terminated). Three
+A Ctrl-C or SIGTERM normally ends implc cleanly (KeyboardInterrupt, Terminated). Three
 places cannot take one: Mesa's shader compile (a system call it interrupted is not
 retried: moderngl's ctx.program segfaulted, test_fault[gallery-SIGINT], about 1 run in 4
 under load), the import of a nanobind extension (OpenImageIO, pyopencl: an exception

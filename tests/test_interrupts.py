@@ -89,18 +89,25 @@ def test_python_m_implc_exits_with_its_code_after_a_caught_interrupt(tmp_path):
     """A KeyboardInterrupt that escaped an exec() of a string (as one does when Ctrl-C
     lands while a dataclass is being defined in a lazy import) made `python -m implc` die
     by SIGINT (-2) although main() caught it and returned 130."""
-    (tmp_path / "interrupted_in_exec.py").write_text(
-        "import runpy, sys\n"
+    proc = _python_m_implc_list(tmp_path, "def listed(args):\n"
+                                          "    exec('raise KeyboardInterrupt')\n")
+    assert (proc.returncode, proc.stderr) == (130, "implc: interrupted\n")
+
+
+def _python_m_implc_list(tmp_path: Path, listed: str) -> subprocess.CompletedProcess:
+    """`python -m implc list` with `listed` (source defining `listed(args)`) as the
+    command, from a module of its own run by `python -m` (SIGINT at its default)."""
+    (tmp_path / "patched_list.py").write_text(
+        "import os, runpy, signal, sys\n"
         "import implc.cli\n"
-        "def interrupted(args):\n"
-        "    exec('raise KeyboardInterrupt')\n"
-        "implc.cli.cmd_list = interrupted\n"
+        f"{listed}"
+        "implc.cli.cmd_list = listed\n"
         "sys.argv = ['implc', 'list']\n"
         "runpy.run_module('implc', run_name='__main__')\n")
-    proc = subprocess.run([sys.executable, "-m", "interrupted_in_exec"], cwd=tmp_path,
+    return subprocess.run([sys.executable, "-m", "patched_list"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)})
-    assert (proc.returncode, proc.stderr) == (130, "implc: interrupted\n")
+                          env={**os.environ, "PYTHONPATH": str(ROOT)},
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _interrupting(real):
@@ -174,11 +181,10 @@ def test_an_output_is_not_put_in_place_after_a_dropped_interrupt(tmp_path):
 
 
 def test_implc_exits_interrupted_after_a_dropped_interrupt(tmp_path):
-    """Ctrl-C in importlib's module-lock callback was dropped by Python, and `implc bench`
+    """Ctrl-C in the import system's module-lock callback was dropped by Python, and `implc bench`
     finished and exited 0 (test_fault[bench-SIGINT] in CI)."""
-    (tmp_path / "dropped_interrupt.py").write_text(
-        "import runpy, signal, sys, os\n"
-        "import implc.cli\n"
+    proc = _python_m_implc_list(
+        tmp_path,
         "class InterruptedWhenCollected:\n"
         "    def __del__(self):\n"
         "        os.kill(os.getpid(), signal.SIGINT)\n"
@@ -186,12 +192,5 @@ def test_implc_exits_interrupted_after_a_dropped_interrupt(tmp_path):
         "def listed(args):\n"
         "    InterruptedWhenCollected()\n"
         "    print('listed')\n"
-        "    return 0\n"
-        "implc.cli.cmd_list = listed\n"
-        "sys.argv = ['implc', 'list']\n"
-        "runpy.run_module('implc', run_name='__main__')\n")
-    proc = subprocess.run([sys.executable, "-m", "dropped_interrupt"], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=120,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)},
-                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        "    return 0\n")
     assert (proc.returncode, proc.stderr) == (130, "implc: interrupted\n")
