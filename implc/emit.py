@@ -143,7 +143,7 @@ def emit(
             {param_symbol(u.name): sympy.Symbol(u.ref, real=True) for u in uniforms})
         equation = surface.symbolic_equation
     # the same form as with --params constant
-    form = choose_form(surface.expr, evaluation or constants.evaluation)
+    form = choose_form(meth, surface.expr, evaluation or constants.evaluation)
     carried = (("Params", "params"),) if uniforms and tgt.params_read_as == "argument" else ()
     marcher = lower(meth, constants, expr, form, printer, prefix, current_max_derived(),
                     carried)

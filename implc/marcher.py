@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import sympy
 
-from .derive import polynomial_degree
+from .derive import current_max_derived, polynomial_degree
 from .errors import InputError
 from .interval import (
     check_interval,
@@ -49,7 +49,7 @@ from .methods import (
     constant_values,
 )
 from .optimize import arrange_by_depth
-from .options import AUTO_MAX_DEGREE, EVAL_CHOICES, EXACT_MAX_DEGREE
+from .options import EVAL_CHOICES, EXACT_MAX_DEGREE
 from .pieces import (
     COMPONENT,
     QUANTITY_ORDER,
@@ -61,10 +61,18 @@ from .pieces import (
     point_function,
     sym,
 )
-from .raypoly import carry, coefficient_program, estrin_function, from_ray, ray_name, ray_setup
+from .raypoly import (
+    carry,
+    coefficient_program,
+    estrin_function,
+    from_ray,
+    ray_name,
+    ray_quantity_ops,
+    ray_setup,
+)
 from .solver import check_exact, lower_solver
 
-# EVAL_CHOICES and AUTO_MAX_DEGREE (`auto`'s rule) are plain data in implc/options.py
+# EVAL_CHOICES is plain data in implc/options.py
 
 # When the root test's inputs are ready, in operations (optimize.arrange_by_depth): the
 # start sample (F0, F0', X0) first (depth 0), then the step length h, after the step rule,
@@ -88,8 +96,12 @@ _MARCH_POINT = "(ray.o + s0*ray.d) + h*ray.d"  # values_at's point: s = s0 + h
 REFINE_SET = ("S", "dS")
 
 
-def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
-    """The evaluation form for `expr`: `point` or `ray-poly` (see AUTO_MAX_DEGREE)."""
+def choose_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> str:
+    """The evaluation form `method`'s shader for `expr` uses when `requested` is asked (as
+    `lower` prints it; what a render's sidecar records): the exact solver works on the ray
+    polynomial, the interval method at points. A marcher takes what is asked, and under
+    `auto` the form whose march step evaluates fewer operations (step_ops): measured,
+    the faster one on every surface timed in both forms (docs/RESULTS.md section 2)."""
     if requested not in EVAL_CHOICES:
         raise InputError(f"unknown evaluation form '{requested}'; choose from "
                          f"{', '.join(EVAL_CHOICES)}")
@@ -97,19 +109,27 @@ def choose_form(expr: sympy.Expr, requested: str = "auto") -> str:
     if requested == "ray-poly" and degree is None:
         raise InputError("--eval ray-poly needs a polynomial surface; this one is not "
                          "(use --eval point or auto)")
-    if requested != "auto":
-        return requested
-    return "ray-poly" if degree is not None and degree <= AUTO_MAX_DEGREE else "point"
-
-
-def used_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> str:
-    """The evaluation form `method`'s shader for `expr` uses when `requested` is asked (as
-    `lower` prints it; what a render's sidecar records): the exact solver works on the ray
-    polynomial, the interval method at points, a marcher takes `choose_form`'s."""
-    form = choose_form(expr, requested)
     if method.solves:
         return "ray-poly"
-    return "point" if method.bounds else form
+    if method.bounds or degree is None:
+        return "point"
+    if requested != "auto":
+        return requested
+    cheaper = step_ops(method, expr, "ray-poly") < step_ops(method, expr, "point")
+    return "ray-poly" if cheaper else "point"
+
+
+def step_ops(method: Method, expr: sympy.Expr, form: str) -> int:
+    """Operations a march step of `method` evaluates in `form` (`--eval auto`'s measure,
+    `implc show` prints it): its point functions after optimization, plus Estrin's sums
+    for the ray derivatives. The ray coefficients, once a ray, are left out: a marcher
+    takes hundreds of steps a ray at the paper's b = 0.01."""
+    degree = polynomial_degree(expr)
+    programs = build_programs(expr, point_sets(method, form), current_max_derived())
+    calls = [call for quantities in _sample_groups(method).values()
+             for call in _split(quantities, form)]
+    return sum(programs[function_name(qs)].ops_after if kind == "point" else
+               sum(ray_quantity_ops(degree, q) for q in qs) for kind, qs in calls)
 
 
 def default_method(expr: sympy.Expr) -> str:

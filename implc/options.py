@@ -1,5 +1,6 @@
 """What the command line offers, as plain data: the method names, the marcher's
-constants, the evaluation forms and the exact method's degree bound.
+constants, the evaluation forms (`auto`'s rule is implc/marcher.py's choose_form) and the
+exact method's degree bound.
 
 No sympy or numpy here, so that `implc --help`, `implc COMMAND --help` and `--version`
 start in a fraction of the time the registries take to import (`make startup`). The
@@ -17,13 +18,6 @@ METHOD_NAMES = ("sign", "taylor", "curvature", "hessian", "hessian-approx", "exa
 # Evaluation forms (implc/marcher.py): how F, F', F'' are computed along a ray.
 FORMS = ("point", "ray-poly")
 EVAL_CHOICES = ("auto", *FORMS)
-# `auto` takes ray-poly for polynomials up to this degree (docs/RESULTS.md, "Evaluation
-# forms"): as accurate as point evaluation at every degree measured (2 to 12), and faster
-# on every bundled polynomial (degree 2 to 6, 3-26 %); above degree 6 the point form was
-# as fast or faster with Horner's F' (sums of n-th powers evaluate cheaply at a point by
-# power chains). With Estrin's F', ray-poly measured as fast or faster up to degree 12 in
-# one run (RESULTS section 2); not re-decided on that alone.
-AUTO_MAX_DEGREE = 6
 
 # The exact method's highest degree. Float32 root isolation through the expanded ray
 # polynomial loses accuracy with the degree and the coefficients' size; measured at 512^2

@@ -6,7 +6,7 @@ import sympy
 
 from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
-from .marcher import AUTO_MAX_DEGREE, evaluations
+from .marcher import choose_form, evaluations, step_ops
 from .methods import Method
 from .raypoly import HORNER_ABOVE, coefficient_program, coefficient_route, ray_quantity_ops
 from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES
@@ -71,6 +71,9 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
     """The ray-poly form's costs: once per ray (the coefficients) and per march step."""
     if degree is None:
         return ["", "ray-poly form: not available (S is not a polynomial)"]
+    if method.bounds:
+        return ["", "ray-poly form: not used (the interval method encloses S's tree over "
+                    "segments)"]
     coefficients = coefficient_program(surface.expr)
     if method.solves:
         return [
@@ -88,9 +91,12 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
                          for q in dict.fromkeys(quantities))
     point = [" + ".join(qs) for kind, qs in evaluations(method, "ray-poly")
              if kind == "point" and qs not in (("S",), ("grad",))]
+    costs = {form: step_ops(method, surface.expr, form) for form in ("point", "ray-poly")}
     return [
         "",
-        f"ray-poly form (chosen by --eval auto up to degree {AUTO_MAX_DEGREE}):",
+        f"per march step: point form {costs['point']} ops, ray-poly form "
+        f"{costs['ray-poly']} ops; --eval auto takes {choose_form(method, surface.expr)}",
+        "ray-poly form:",
         f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
         f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",
         f"  per evaluation, Estrin's scheme (powers of s included, shared between F' and "

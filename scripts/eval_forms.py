@@ -127,7 +127,7 @@ def _measured_row(first: str, surface, size: int, frames: int) -> tuple[dict, fl
     """Measure `surface` (measure_sweep), print its table row after the cells `first`,
     and return the measurements and exact / taylor (the form `--eval auto` picks)."""
     r = measure_sweep(surface, size, frames)
-    taylor = r["taylor", choose_form(surface.expr)]
+    taylor = r["taylor", choose_form(get_method("taylor"), surface.expr)]
     exact = r["exact", "auto"]
     counts = [f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
               for c in (exact, taylor, r["hessian", "auto"])]

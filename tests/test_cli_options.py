@@ -319,3 +319,32 @@ def test_the_sidecar_records_the_form_used(tmp_path):
         assert proc.returncode == 0, proc.stderr
         sidecar = json.loads(out.with_suffix(".json").read_text())
         assert sidecar["method"]["evaluation"] == form, method
+
+
+@pytest.mark.parametrize("spec, method, form", [
+    # sums of powers evaluate cheaply at a point by power chains: 29 against 40 operations
+    # a step, and the point program measured 1.10x faster at 512^2 (docs/RESULTS.md)
+    ("x^12 + y^12 + z^12 - 1", "taylor", "point"),
+    ("x^12 + y^12 + z^12 - 1", "hessian", "point"),
+    # Barth's decic: 104 against 56 (taylor), 297 against 83 (hessian); ray-poly measured
+    # 1.30x and 1.95x faster
+    ("barth-decic", "taylor", "ray-poly"),
+    ("barth-decic", "hessian", "ray-poly"),
+    ("cross-cap", "sign", "ray-poly"),
+])
+def test_auto_takes_the_form_whose_march_step_costs_less(spec, method, form):
+    """`--eval auto` is the form with fewer operations a march step (implc show prints
+    both), and the program it emits is that form's."""
+    from implc.emit import emit
+    from implc.marcher import choose_form, step_ops
+    from implc.methods import METHODS
+    from implc.options import FORMS
+    from implc.surface import load_surface
+
+    surface = load_surface(equation=spec) if "=" in spec or "^" in spec else load_surface(spec)
+    meth = METHODS[method]
+    other, = set(FORMS) - {form}
+    assert step_ops(meth, surface.expr, form) < step_ops(meth, surface.expr, other)
+    assert choose_form(meth, surface.expr) == form
+    assert emit(surface, "glsl", method) == emit(surface, "glsl", method, evaluation=form)
+    assert emit(surface, "glsl", method) != emit(surface, "glsl", method, evaluation=other)

@@ -54,13 +54,12 @@ def test_the_light_tables_are_the_registries():
     """What the command line offers without importing the registries (implc/options.py)
     is what the registries hold."""
     from implc.backends.opencl import PRECISIONS
-    from implc.marcher import AUTO_MAX_DEGREE, EVAL_CHOICES
+    from implc.marcher import EVAL_CHOICES
     from implc.methods import METHODS
-    from implc.options import AUTO_MAX_DEGREE as LIGHT_AUTO
     from implc.options import EVAL_CHOICES as LIGHT_EVAL
     from implc.options import METHOD_NAMES
     from implc.targets import TARGETS
 
     assert tuple(METHODS) == METHOD_NAMES
-    assert (EVAL_CHOICES, AUTO_MAX_DEGREE) == (LIGHT_EVAL, LIGHT_AUTO)
+    assert EVAL_CHOICES == LIGHT_EVAL
     assert TARGETS["opencl"].precisions == PRECISIONS

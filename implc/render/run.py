@@ -126,10 +126,10 @@ def metadata(
     if backend == REFERENCE:
         method_json = {"name": REFERENCE}
     else:
-        from ..marcher import used_form
+        from ..marcher import choose_form
         from ..methods import get_method
 
-        form = used_form(get_method(method), surface.expr, constants.evaluation)
+        form = choose_form(get_method(method), surface.expr, constants.evaluation)
         method_json = {"name": method, **constants.as_dict(), "evaluation": form}
     return {
         "surface": {

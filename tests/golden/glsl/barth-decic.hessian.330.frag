@@ -29,6 +29,17 @@ struct Ray {
     vec3 o;  // origin of the march, s = 0: the point ro + sm rd
     vec3 d;  // unit direction
     float sm;  // where o lies on the caller's ray: t = sm + s
+    float c0;  // coefficient of u^0
+    float c1;  // coefficient of u^1
+    float c2;  // coefficient of u^2
+    float c3;  // coefficient of u^3
+    float c4;  // coefficient of u^4
+    float c5;  // coefficient of u^5
+    float c6;  // coefficient of u^6
+    float c7;  // coefficient of u^7
+    float c8;  // coefficient of u^8
+    float c9;  // coefficient of u^9
+    float c10;  // coefficient of u^10
 };
 
 struct Hit {
@@ -99,14 +110,34 @@ vec3 grad(vec3 p) {
     return vec3((t0*t5 + 16.0*t10*t14) + (-109.665631459995*t14*t15 + (t0*t4 + t11*(4.0*x_3 + (-t6*y_2 - t6*z_2)))), (-109.665631459995*t10*t18 + (t11*(4.0*y_3 + (-t17*x_2 - t17*z_2)) + t16*t4)) + (t16*t5 + 16.0*t18*t19), (16.0*t15*t22 + t20*t5) + (-109.665631459995*t19*t22 + (t11*(4.0*z_3 + (-t21*x_2 - t21*y_2)) + t20*t4)));
 }
 
-// S, dS, d2S at the point p along the unit direction d
-vec3 SDH(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
+// dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
+vec2 ray_DH(Ray ray, float s) {
+    float s_2 = s*s;
+    float s_4 = s_2*s_2;
+    float s_8 = s_4*s_4;
+    return vec2((10.0*ray.c10*s + 9.0*ray.c9)*s_8 + (((7.0*ray.c7 + 8.0*ray.c8*s)*s_2 + (5.0*ray.c5 + 6.0*ray.c6*s))*s_4 + ((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s))), 10.0*ray.c10*(9.0*s_8) + (((56.0*ray.c8 + 9.0*ray.c9*(8.0*s))*s_2 + (30.0*ray.c6 + 7.0*ray.c7*(6.0*s)))*s_4 + ((12.0*ray.c4 + 5.0*ray.c5*(4.0*s))*s_2 + (2.0*ray.c2 + 3.0*ray.c3*(2.0*s)))));
+}
+
+// dS at march parameter s: Estrin's scheme on the ray polynomial
+float ray_dS(Ray ray, float s) {
+    float s_2 = s*s;
+    float s_4 = s_2*s_2;
+    float s_8 = s_4*s_4;
+    return (10.0*ray.c10*s + 9.0*ray.c9)*s_8 + (((7.0*ray.c7 + 8.0*ray.c8*s)*s_2 + (5.0*ray.c5 + 6.0*ray.c6*s))*s_4 + ((3.0*ray.c3 + 4.0*ray.c4*s)*s_2 + (ray.c1 + 2.0*ray.c2*s)));
+}
+
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
+Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
+    vec3 oc = ro + sm*rd;
+    float x = oc.x;
+    float y = oc.y;
+    float z = oc.z;
+    float dx = rd.x;
+    float dy = rd.y;
+    float dz = rd.z;
     float x_2 = x*x;
     float x_3 = x*x_2;
     float x_4 = x_2*x_2;
@@ -117,140 +148,103 @@ vec3 SDH(vec3 p, vec3 d) {
     float z_3 = z*z_2;
     float z_4 = z_2*z_2;
     float dx_2 = dx*dx;
+    float dx_3 = dx*dx_2;
+    float dx_4 = dx_2*dx_2;
     float dy_2 = dy*dy;
+    float dy_3 = dy*dy_2;
+    float dy_4 = dy_2*dy_2;
     float dz_2 = dz*dz;
+    float dz_3 = dz*dz_2;
+    float dz_4 = dz_2*dz_2;
     float t0 = z_2 + (x_2 + y_2);
-    float t1 = t0 - 1.0;
+    float t1 = t0 - 0.381966011250105;
     float t1_2 = t1*t1;
-    float t2 = t0 - 0.381966011250105;
+    float t2 = t0 - 1.0;
     float t2_2 = t2*t2;
-    float t3 = x_2 - 6.854101966249687*y_2;
-    float t4 = y_2 - 6.854101966249687*z_2;
-    float t5 = 2.0*x_2;
-    float t6 = (-t5*y_2 - t5*z_2) + ((x_4 + y_4) + (-2.0*y_2*z_2 + z_4));
-    float t7 = t4*t6;
-    float t8 = t3*t7;
-    float t9 = -6.854101966249687*x_2 + z_2;
-    float t10 = 8.0*t9;
-    float t11 = 44.3606797749979*t1*t2_2;
-    float t12 = 44.3606797749979*t1_2*t2;
-    float t13 = 4.0*y_2;
-    float t14 = 4.0*z_2;
-    float t15 = -t14*x + (-t13*x + 4.0*x_3);
-    float t16 = t15*t4;
-    float t17 = t10*t3;
-    float t18 = 16.0*t9;
-    float t19 = t18*t7;
-    float t20 = 109.665631459995*t7;
-    float t21 = t20*t3;
-    float t22 = 4.0*x_2;
-    float t23 = -t22*y + (-t14*y + 4.0*y_3);
-    float t24 = t17*t4;
-    float t25 = t3*t6;
-    float t26 = t18*t25;
-    float t27 = t20*t9;
-    float t28 = -t22*z + (-t13*z + 4.0*z_3);
-    float t29 = 109.665631459995*t9;
-    float t30 = t25*t29;
-    float t31 = 16.0*t8;
-    float t32 = 88.7213595499958*x;
-    float t33 = t32*y;
-    float t34 = 354.8854381999832*t1*t2;
-    float t35 = x*y;
-    float t36 = t4*t9;
-    float t37 = 64.0*t3*t36;
-    float t38 = t23*x;
-    float t39 = t18*t4;
-    float t40 = t3*t4;
-    float t41 = 109.665631459995*t40;
-    float t42 = t15*t3;
-    float t43 = t18*y;
-    float t44 = t29*y;
-    float t45 = t6*t9;
-    float t46 = 2.0*dx;
-    float t47 = t32*z;
-    float t48 = x*z;
-    float t49 = t28*x;
-    float t50 = t29*z;
-    float t51 = 16.0*z;
-    float t52 = y*z;
-    float t53 = 88.7213595499958*t52;
-    float t54 = 88.7213595499958*x_2;
-    float t55 = t16*x;
-    float t56 = 32.0*t9;
-    float t57 = 219.33126291999*t3;
-    float t58 = t11 + t12;
-    float t59 = 88.7213595499958*y_2;
-    float t60 = t23*y;
-    float t61 = 88.7213595499958*z_2;
-    float t62 = t28*z;
-    return vec3(t10*t8 + 11.090169943749475*t1_2*t2_2, dz*((t24*t28 - t30*z) + (t31*z + (t11*z + t12*z))) + (dx*((t16*t17 + t19*x) + (-t21*x + (t11*x + t12*x))) + dy*((t23*t24 + t26*y) + (-t27*y + (t11*y + t12*y)))), (dy*t46*(((-t16*t44 - t38*t41) + (-219.33126291999*t25*t35 + 32.0*t35*t45)) + ((1503.3188404399305*t35*t7 + (t1_2*t33 + t2_2*t33)) + ((t34*t35 - t35*t37) + (t38*t39 + t42*t43)))) + dz*t46*(((1503.3188404399305*t25*t48 - 219.33126291999*t45*t48) + (-t42*t50 + 32.0*t48*t7)) + ((t16*t3*t51 + (t1_2*t47 + t2_2*t47)) + ((t34*t48 - t37*t48) + (t39*t49 - t41*t49))))) + ((dx_2*((-t21 + (-438.66252583998*t7*x_2 + (t1_2*t54 + t2_2*t54))) + ((t55*t56 - t55*t57) + ((t19 + t34*x_2) + (t24*(-t14 + (-t13 + 12.0*x_2)) + t58)))) + 2.0*dy*dz*(((32.0*t25*t52 - 219.33126291999*t52*t7) + (-t23*t3*t50 - t28*t4*t44)) + ((1503.3188404399305*t45*t52 + (t1_2*t53 + t2_2*t53)) + ((t34*t52 - t37*t52) + (t23*t40*t51 + t28*t3*t43))))) + (dy_2*((-t27 + ((t26 + t34*y_2) + (t24*(-t22 + (-t14 + 12.0*y_2)) + t58))) + ((-219.33126291999*t36*t60 - 438.66252583998*t45*y_2) + (t3*t56*t60 + (t1_2*t59 + t2_2*t59)))) + dz_2*(((-t30 + (t34*z_2 + t58)) + (t31 + (t1_2*t61 + t2_2*t61))) + ((t24*(-t22 + (-t13 + 12.0*z_2)) + 32.0*t40*t62) + (-438.66252583998*t25*z_2 - t57*t62*t9))))));
-}
-
-// S, dS at the point p along the unit direction d
-vec2 SD(vec3 p, vec3 d) {
-    float x = p.x;
-    float y = p.y;
-    float z = p.z;
-    float dx = d.x;
-    float dy = d.y;
-    float dz = d.z;
-    float x_2 = x*x;
-    float x_3 = x*x_2;
-    float x_4 = x_2*x_2;
-    float y_2 = y*y;
-    float y_3 = y*y_2;
-    float y_4 = y_2*y_2;
-    float z_2 = z*z;
-    float z_3 = z*z_2;
-    float z_4 = z_2*z_2;
-    float t0 = z_2 + (x_2 + y_2);
-    float t1 = t0 - 1.0;
-    float t1_2 = t1*t1;
-    float t2 = t0 - 0.381966011250105;
-    float t2_2 = t2*t2;
-    float t3 = y_2 - 6.854101966249687*z_2;
-    float t4 = -6.854101966249687*x_2 + z_2;
-    float t5 = 2.0*x_2;
-    float t6 = (-t5*y_2 - t5*z_2) + ((x_4 + y_4) + (-2.0*y_2*z_2 + z_4));
-    float t7 = t3*t4*t6;
-    float t8 = x_2 - 6.854101966249687*y_2;
-    float t9 = 8.0*t8;
-    float t10 = 44.3606797749979*x;
-    float t11 = t1*t2_2;
-    float t12 = t1_2*t2;
-    float t13 = 4.0*x;
-    float t14 = t3*t4*t9;
-    float t15 = t6*t8;
-    float t16 = t15*t3;
-    float t17 = 44.3606797749979*y;
-    float t18 = 4.0*y;
-    float t19 = t15*t4;
-    float t20 = 44.3606797749979*z;
-    float t21 = 4.0*z;
-    return vec2(11.090169943749475*t1_2*t2_2 + t7*t9, dz*((t12*t20 + 16.0*t16*z) + (-109.665631459995*t19*z + (t11*t20 + t14*(4.0*z_3 + (-t21*x_2 - t21*y_2))))) + (dx*((t10*t12 + 16.0*t7*x) + (-109.665631459995*t16*x + (t10*t11 + t14*(4.0*x_3 + (-t13*y_2 - t13*z_2))))) + dy*((t12*t17 - 109.665631459995*t7*y) + (16.0*t19*y + (t11*t17 + t14*(4.0*y_3 + (-t18*x_2 - t18*z_2)))))));
-}
-
-// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
-// (hr its half length).
-// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
-// and the march adds no offset to s before it evaluates.
-Ray ray_of(vec3 ro, vec3 rd, float sm, float hr) {
-    vec3 oc = ro + sm*rd;
-    return Ray(oc, rd, sm);
+    float t3 = 11.090169943749475*t2_2;
+    float t4 = 2.0*x_2;
+    float t5 = 2.0*y_2;
+    float t6 = (-t4*z_2 - t5*z_2) + ((x_4 + y_4) + (-t4*y_2 + z_4));
+    float t7 = -6.854101966249687*x_2 + z_2;
+    float t8 = y_2 - 6.854101966249687*z_2;
+    float t9 = 8.0*x_2 - 54.8328157299975*y_2;
+    float t10 = t8*t9;
+    float t11 = t10*t7;
+    float t12 = dx*x;
+    float t13 = dy*y;
+    float t14 = 2.0*t13;
+    float t15 = dz*z;
+    float t16 = 2.0*t15 + (2.0*t12 + t14);
+    float t16_2 = t16*t16;
+    float t17 = 22.18033988749895*t2;
+    float t18 = t16*t17;
+    float t19 = 22.18033988749895*t16;
+    float t20 = t19*t2_2;
+    float t21 = 4.0*t12;
+    float t22 = 4.0*t13;
+    float t23 = 4.0*t15;
+    float t24 = ((4.0*dx*x_3 + 4.0*dy*y_3) + (4.0*dz*z_3 + (-t21*y_2 - t21*z_2))) + ((-t22*x_2 - t22*z_2) + (-t23*x_2 - t23*y_2));
+    float t25 = 2.0*dz*z - 13.708203932499375*t12;
+    float t26 = 16.0*t12 - 109.665631459995*t13;
+    float t27 = t14 - 13.708203932499375*t15;
+    float t28 = t26*t8 + t27*t9;
+    float t29 = t10*t25 + t28*t7;
+    float t30 = 44.3606797749979*t16_2;
+    float t31 = t2*t30;
+    float t32 = dz_2 + (dx_2 + dy_2);
+    float t32_2 = t32*t32;
+    float t32_3 = t32*t32_2;
+    float t32_4 = t32_2*t32_2;
+    float t33 = 2.0*t1;
+    float t34 = t16_2 + t32*t33;
+    float t35 = 11.090169943749475*t16_2 + t17*t32;
+    float t36 = 8.0*t12;
+    float t37 = 2.0*z_2;
+    float t38 = ((-dz_2*t4 - dz_2*t5) + (-t13*t36 - t15*t36)) + (((-dx_2*t37 - dx_2*t5) + (-dy_2*t37 - dy_2*t4)) + ((6.0*dx_2*x_2 - 8.0*t13*t15) + (6.0*dy_2*y_2 + 6.0*dz_2*z_2)));
+    float t39 = -6.854101966249687*dx_2 + dz_2;
+    float t40 = 8.0*dx_2 - 54.8328157299975*dy_2;
+    float t41 = dy_2 - 6.854101966249687*dz_2;
+    float t42 = t41*t9 + (t26*t27 + t40*t8);
+    float t43 = t42*t7 + (t10*t39 + t25*t28);
+    float t44 = t19*t32;
+    float t45 = t16*t35;
+    float t46 = ((4.0*dx_3*x + 4.0*dy_3*y) + (4.0*dz_3*z + (-dx_2*t22 - dx_2*t23))) + ((-dy_2*t21 - dy_2*t23) + (-dz_2*t21 - dz_2*t22));
+    float t47 = t26*t41 + t27*t40;
+    float t48 = t25*t42 + (t28*t39 + t47*t7);
+    float t49 = 11.090169943749475*t32_2;
+    float t50 = 2.0*dx_2;
+    float t51 = (-dy_2*t50 - dz_2*t50) + ((dx_4 + dy_4) + (-2.0*dy_2*dz_2 + dz_4));
+    float t52 = t40*t41;
+    float t53 = t39*t42 + (t25*t47 + t52*t7);
+    float t54 = t25*t52 + t39*t47;
+    float t55 = t39*t52;
+    float c0 = t11*t6 + t1_2*t3;
+    float c1 = (t1*t20 + t18*t1_2) + (t11*t24 + t29*t6);
+    float c2 = (t3*t34 + t43*t6) + ((t1*t31 + t11*t38) + (t1_2*t35 + t24*t29));
+    float c3 = (t48*t6 + (t11*t46 + t18*t34)) + ((t24*t43 + t33*t45) + (t29*t38 + (t1_2*t44 + t20*t32)));
+    float c4 = ((t24*t48 + (t1*t30*t32 + t3*t32_2)) + (t38*t43 + t53*t6)) + ((t29*t46 + (t11*t51 + t1_2*t49)) + (t31*t32 + t34*t35));
+    float c5 = ((t24*t53 + t38*t48) + (2.0*t32*t45 + t43*t46)) + ((t29*t51 + t34*t44) + (t54*t6 + (t1*t19*t32_2 + t18*t32_2)));
+    float c6 = (t46*t48 + (t24*t54 + t32_2*t35)) + ((t34*t49 + (t30*t32_2 + t55*t6)) + (t38*t53 + t43*t51));
+    float c7 = (t38*t54 + t46*t53) + (t48*t51 + (44.3606797749979*t16*t32_3 + t24*t55));
+    float c8 = (11.090169943749475*t32_4 + t38*t55) + (t46*t54 + t51*t53);
+    float c9 = t46*t55 + t51*t54;
+    float c10 = t51*t55;
+    return Ray(oc, rd, sm, c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is
 // s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
 vec3 values_at(Ray ray, float s, float s0, float h) {
-    vec3 e0 = SDH((ray.o + s0*ray.d) + h*ray.d, ray.d);
-    return vec3(e0.x, e0.y, e0.z);
+    vec2 e0 = ray_DH(ray, s);
+    float e1 = S((ray.o + s0*ray.d) + h*ray.d);
+    return vec3(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 vec2 fd(Ray ray, float s) {
-    vec2 e0 = SD(ray.o + s*ray.d, ray.d);
-    return vec2(e0.x, e0.y);
+    float e0 = ray_dS(ray, s);
+    float e1 = S(ray.o + s*ray.d);
+    return vec2(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.

@@ -39,6 +39,17 @@ struct Ray {
     o: vec3<f32>,  // origin of the march, s = 0: the point ro + sm rd
     d: vec3<f32>,  // unit direction
     sm: f32,  // where o lies on the caller's ray: t = sm + s
+    c0: f32,  // coefficient of u^0
+    c1: f32,  // coefficient of u^1
+    c2: f32,  // coefficient of u^2
+    c3: f32,  // coefficient of u^3
+    c4: f32,  // coefficient of u^4
+    c5: f32,  // coefficient of u^5
+    c6: f32,  // coefficient of u^6
+    c7: f32,  // coefficient of u^7
+    c8: f32,  // coefficient of u^8
+    c9: f32,  // coefficient of u^9
+    c10: f32,  // coefficient of u^10
 }
 
 struct Hit {
@@ -109,14 +120,34 @@ fn grad(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>((t0*t5 + 16.0f*t10*t14) + (-109.665631459995f*t14*t15 + (t0*t4 + t11*(4.0f*x_3 + (-t6*y_2 - t6*z_2)))), (-109.665631459995f*t10*t18 + (t11*(4.0f*y_3 + (-t17*x_2 - t17*z_2)) + t16*t4)) + (t16*t5 + 16.0f*t18*t19), (16.0f*t15*t22 + t20*t5) + (-109.665631459995f*t19*t22 + (t11*(4.0f*z_3 + (-t21*x_2 - t21*y_2)) + t20*t4)));
 }
 
-// S, dS, d2S at the point p along the unit direction d
-fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
+// dS, d2S at march parameter s: Estrin's scheme on the ray polynomial
+fn ray_DH(ray: Ray, s: f32) -> vec2<f32> {
+    let s_2: f32 = s*s;
+    let s_4: f32 = s_2*s_2;
+    let s_8: f32 = s_4*s_4;
+    return vec2<f32>((10.0f*ray.c10*s + 9.0f*ray.c9)*s_8 + (((7.0f*ray.c7 + 8.0f*ray.c8*s)*s_2 + (5.0f*ray.c5 + 6.0f*ray.c6*s))*s_4 + ((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s))), 10.0f*ray.c10*(9.0f*s_8) + (((56.0f*ray.c8 + 9.0f*ray.c9*(8.0f*s))*s_2 + (30.0f*ray.c6 + 7.0f*ray.c7*(6.0f*s)))*s_4 + ((12.0f*ray.c4 + 5.0f*ray.c5*(4.0f*s))*s_2 + (2.0f*ray.c2 + 3.0f*ray.c3*(2.0f*s)))));
+}
+
+// dS at march parameter s: Estrin's scheme on the ray polynomial
+fn ray_dS(ray: Ray, s: f32) -> f32 {
+    let s_2: f32 = s*s;
+    let s_4: f32 = s_2*s_2;
+    let s_8: f32 = s_4*s_4;
+    return (10.0f*ray.c10*s + 9.0f*ray.c9)*s_8 + (((7.0f*ray.c7 + 8.0f*ray.c8*s)*s_2 + (5.0f*ray.c5 + 6.0f*ray.c6*s))*s_4 + ((3.0f*ray.c3 + 4.0f*ray.c4*s)*s_2 + (ray.c1 + 2.0f*ray.c2*s)));
+}
+
+// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
+// (hr its half length), with the coefficients of F(s) = S(o + s d) = sum c_k s^k.
+// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
+// and the march adds no offset to s before it evaluates.
+fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
+    let oc: vec3<f32> = ro + sm*rd;
+    let x: f32 = oc.x;
+    let y: f32 = oc.y;
+    let z: f32 = oc.z;
+    let dx: f32 = rd.x;
+    let dy: f32 = rd.y;
+    let dz: f32 = rd.z;
     let x_2: f32 = x*x;
     let x_3: f32 = x*x_2;
     let x_4: f32 = x_2*x_2;
@@ -127,140 +158,103 @@ fn SDH(p: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
     let z_3: f32 = z*z_2;
     let z_4: f32 = z_2*z_2;
     let dx_2: f32 = dx*dx;
+    let dx_3: f32 = dx*dx_2;
+    let dx_4: f32 = dx_2*dx_2;
     let dy_2: f32 = dy*dy;
+    let dy_3: f32 = dy*dy_2;
+    let dy_4: f32 = dy_2*dy_2;
     let dz_2: f32 = dz*dz;
+    let dz_3: f32 = dz*dz_2;
+    let dz_4: f32 = dz_2*dz_2;
     let t0: f32 = z_2 + (x_2 + y_2);
-    let t1: f32 = t0 - 1.0f;
+    let t1: f32 = t0 - 0.381966011250105f;
     let t1_2: f32 = t1*t1;
-    let t2: f32 = t0 - 0.381966011250105f;
+    let t2: f32 = t0 - 1.0f;
     let t2_2: f32 = t2*t2;
-    let t3: f32 = x_2 - 6.854101966249687f*y_2;
-    let t4: f32 = y_2 - 6.854101966249687f*z_2;
-    let t5: f32 = 2.0f*x_2;
-    let t6: f32 = (-t5*y_2 - t5*z_2) + ((x_4 + y_4) + (-2.0f*y_2*z_2 + z_4));
-    let t7: f32 = t4*t6;
-    let t8: f32 = t3*t7;
-    let t9: f32 = -6.854101966249687f*x_2 + z_2;
-    let t10: f32 = 8.0f*t9;
-    let t11: f32 = 44.3606797749979f*t1*t2_2;
-    let t12: f32 = 44.3606797749979f*t1_2*t2;
-    let t13: f32 = 4.0f*y_2;
-    let t14: f32 = 4.0f*z_2;
-    let t15: f32 = -t14*x + (-t13*x + 4.0f*x_3);
-    let t16: f32 = t15*t4;
-    let t17: f32 = t10*t3;
-    let t18: f32 = 16.0f*t9;
-    let t19: f32 = t18*t7;
-    let t20: f32 = 109.665631459995f*t7;
-    let t21: f32 = t20*t3;
-    let t22: f32 = 4.0f*x_2;
-    let t23: f32 = -t22*y + (-t14*y + 4.0f*y_3);
-    let t24: f32 = t17*t4;
-    let t25: f32 = t3*t6;
-    let t26: f32 = t18*t25;
-    let t27: f32 = t20*t9;
-    let t28: f32 = -t22*z + (-t13*z + 4.0f*z_3);
-    let t29: f32 = 109.665631459995f*t9;
-    let t30: f32 = t25*t29;
-    let t31: f32 = 16.0f*t8;
-    let t32: f32 = 88.7213595499958f*x;
-    let t33: f32 = t32*y;
-    let t34: f32 = 354.8854381999832f*t1*t2;
-    let t35: f32 = x*y;
-    let t36: f32 = t4*t9;
-    let t37: f32 = 64.0f*t3*t36;
-    let t38: f32 = t23*x;
-    let t39: f32 = t18*t4;
-    let t40: f32 = t3*t4;
-    let t41: f32 = 109.665631459995f*t40;
-    let t42: f32 = t15*t3;
-    let t43: f32 = t18*y;
-    let t44: f32 = t29*y;
-    let t45: f32 = t6*t9;
-    let t46: f32 = 2.0f*dx;
-    let t47: f32 = t32*z;
-    let t48: f32 = x*z;
-    let t49: f32 = t28*x;
-    let t50: f32 = t29*z;
-    let t51: f32 = 16.0f*z;
-    let t52: f32 = y*z;
-    let t53: f32 = 88.7213595499958f*t52;
-    let t54: f32 = 88.7213595499958f*x_2;
-    let t55: f32 = t16*x;
-    let t56: f32 = 32.0f*t9;
-    let t57: f32 = 219.33126291999f*t3;
-    let t58: f32 = t11 + t12;
-    let t59: f32 = 88.7213595499958f*y_2;
-    let t60: f32 = t23*y;
-    let t61: f32 = 88.7213595499958f*z_2;
-    let t62: f32 = t28*z;
-    return vec3<f32>(t10*t8 + 11.090169943749475f*t1_2*t2_2, dz*((t24*t28 - t30*z) + (t31*z + (t11*z + t12*z))) + (dx*((t16*t17 + t19*x) + (-t21*x + (t11*x + t12*x))) + dy*((t23*t24 + t26*y) + (-t27*y + (t11*y + t12*y)))), (dy*t46*(((-t16*t44 - t38*t41) + (-219.33126291999f*t25*t35 + 32.0f*t35*t45)) + ((1503.3188404399305f*t35*t7 + (t1_2*t33 + t2_2*t33)) + ((t34*t35 - t35*t37) + (t38*t39 + t42*t43)))) + dz*t46*(((1503.3188404399305f*t25*t48 - 219.33126291999f*t45*t48) + (-t42*t50 + 32.0f*t48*t7)) + ((t16*t3*t51 + (t1_2*t47 + t2_2*t47)) + ((t34*t48 - t37*t48) + (t39*t49 - t41*t49))))) + ((dx_2*((-t21 + (-438.66252583998f*t7*x_2 + (t1_2*t54 + t2_2*t54))) + ((t55*t56 - t55*t57) + ((t19 + t34*x_2) + (t24*(-t14 + (-t13 + 12.0f*x_2)) + t58)))) + 2.0f*dy*dz*(((32.0f*t25*t52 - 219.33126291999f*t52*t7) + (-t23*t3*t50 - t28*t4*t44)) + ((1503.3188404399305f*t45*t52 + (t1_2*t53 + t2_2*t53)) + ((t34*t52 - t37*t52) + (t23*t40*t51 + t28*t3*t43))))) + (dy_2*((-t27 + ((t26 + t34*y_2) + (t24*(-t22 + (-t14 + 12.0f*y_2)) + t58))) + ((-219.33126291999f*t36*t60 - 438.66252583998f*t45*y_2) + (t3*t56*t60 + (t1_2*t59 + t2_2*t59)))) + dz_2*(((-t30 + (t34*z_2 + t58)) + (t31 + (t1_2*t61 + t2_2*t61))) + ((t24*(-t22 + (-t13 + 12.0f*z_2)) + 32.0f*t40*t62) + (-438.66252583998f*t25*z_2 - t57*t62*t9))))));
-}
-
-// S, dS at the point p along the unit direction d
-fn SD(p: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let x: f32 = p.x;
-    let y: f32 = p.y;
-    let z: f32 = p.z;
-    let dx: f32 = d.x;
-    let dy: f32 = d.y;
-    let dz: f32 = d.z;
-    let x_2: f32 = x*x;
-    let x_3: f32 = x*x_2;
-    let x_4: f32 = x_2*x_2;
-    let y_2: f32 = y*y;
-    let y_3: f32 = y*y_2;
-    let y_4: f32 = y_2*y_2;
-    let z_2: f32 = z*z;
-    let z_3: f32 = z*z_2;
-    let z_4: f32 = z_2*z_2;
-    let t0: f32 = z_2 + (x_2 + y_2);
-    let t1: f32 = t0 - 1.0f;
-    let t1_2: f32 = t1*t1;
-    let t2: f32 = t0 - 0.381966011250105f;
-    let t2_2: f32 = t2*t2;
-    let t3: f32 = y_2 - 6.854101966249687f*z_2;
-    let t4: f32 = -6.854101966249687f*x_2 + z_2;
-    let t5: f32 = 2.0f*x_2;
-    let t6: f32 = (-t5*y_2 - t5*z_2) + ((x_4 + y_4) + (-2.0f*y_2*z_2 + z_4));
-    let t7: f32 = t3*t4*t6;
-    let t8: f32 = x_2 - 6.854101966249687f*y_2;
-    let t9: f32 = 8.0f*t8;
-    let t10: f32 = 44.3606797749979f*x;
-    let t11: f32 = t1*t2_2;
-    let t12: f32 = t1_2*t2;
-    let t13: f32 = 4.0f*x;
-    let t14: f32 = t3*t4*t9;
-    let t15: f32 = t6*t8;
-    let t16: f32 = t15*t3;
-    let t17: f32 = 44.3606797749979f*y;
-    let t18: f32 = 4.0f*y;
-    let t19: f32 = t15*t4;
-    let t20: f32 = 44.3606797749979f*z;
-    let t21: f32 = 4.0f*z;
-    return vec2<f32>(11.090169943749475f*t1_2*t2_2 + t7*t9, dz*((t12*t20 + 16.0f*t16*z) + (-109.665631459995f*t19*z + (t11*t20 + t14*(4.0f*z_3 + (-t21*x_2 - t21*y_2))))) + (dx*((t10*t12 + 16.0f*t7*x) + (-109.665631459995f*t16*x + (t10*t11 + t14*(4.0f*x_3 + (-t13*y_2 - t13*z_2))))) + dy*((t12*t17 - 109.665631459995f*t7*y) + (16.0f*t19*y + (t11*t17 + t14*(4.0f*y_3 + (-t18*x_2 - t18*z_2)))))));
-}
-
-// The ray a march runs on, o + s d, from o = ro + sm rd, the middle of the march interval
-// (hr its half length).
-// s is measured from the middle so that |s| <= hr: float32 values along the ray stay small,
-// and the march adds no offset to s before it evaluates.
-fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
-    let oc: vec3<f32> = ro + sm*rd;
-    return Ray(oc, rd, sm);
+    let t3: f32 = 11.090169943749475f*t2_2;
+    let t4: f32 = 2.0f*x_2;
+    let t5: f32 = 2.0f*y_2;
+    let t6: f32 = (-t4*z_2 - t5*z_2) + ((x_4 + y_4) + (-t4*y_2 + z_4));
+    let t7: f32 = -6.854101966249687f*x_2 + z_2;
+    let t8: f32 = y_2 - 6.854101966249687f*z_2;
+    let t9: f32 = 8.0f*x_2 - 54.8328157299975f*y_2;
+    let t10: f32 = t8*t9;
+    let t11: f32 = t10*t7;
+    let t12: f32 = dx*x;
+    let t13: f32 = dy*y;
+    let t14: f32 = 2.0f*t13;
+    let t15: f32 = dz*z;
+    let t16: f32 = 2.0f*t15 + (2.0f*t12 + t14);
+    let t16_2: f32 = t16*t16;
+    let t17: f32 = 22.18033988749895f*t2;
+    let t18: f32 = t16*t17;
+    let t19: f32 = 22.18033988749895f*t16;
+    let t20: f32 = t19*t2_2;
+    let t21: f32 = 4.0f*t12;
+    let t22: f32 = 4.0f*t13;
+    let t23: f32 = 4.0f*t15;
+    let t24: f32 = ((4.0f*dx*x_3 + 4.0f*dy*y_3) + (4.0f*dz*z_3 + (-t21*y_2 - t21*z_2))) + ((-t22*x_2 - t22*z_2) + (-t23*x_2 - t23*y_2));
+    let t25: f32 = 2.0f*dz*z - 13.708203932499375f*t12;
+    let t26: f32 = 16.0f*t12 - 109.665631459995f*t13;
+    let t27: f32 = t14 - 13.708203932499375f*t15;
+    let t28: f32 = t26*t8 + t27*t9;
+    let t29: f32 = t10*t25 + t28*t7;
+    let t30: f32 = 44.3606797749979f*t16_2;
+    let t31: f32 = t2*t30;
+    let t32: f32 = dz_2 + (dx_2 + dy_2);
+    let t32_2: f32 = t32*t32;
+    let t32_3: f32 = t32*t32_2;
+    let t32_4: f32 = t32_2*t32_2;
+    let t33: f32 = 2.0f*t1;
+    let t34: f32 = t16_2 + t32*t33;
+    let t35: f32 = 11.090169943749475f*t16_2 + t17*t32;
+    let t36: f32 = 8.0f*t12;
+    let t37: f32 = 2.0f*z_2;
+    let t38: f32 = ((-dz_2*t4 - dz_2*t5) + (-t13*t36 - t15*t36)) + (((-dx_2*t37 - dx_2*t5) + (-dy_2*t37 - dy_2*t4)) + ((6.0f*dx_2*x_2 - 8.0f*t13*t15) + (6.0f*dy_2*y_2 + 6.0f*dz_2*z_2)));
+    let t39: f32 = -6.854101966249687f*dx_2 + dz_2;
+    let t40: f32 = 8.0f*dx_2 - 54.8328157299975f*dy_2;
+    let t41: f32 = dy_2 - 6.854101966249687f*dz_2;
+    let t42: f32 = t41*t9 + (t26*t27 + t40*t8);
+    let t43: f32 = t42*t7 + (t10*t39 + t25*t28);
+    let t44: f32 = t19*t32;
+    let t45: f32 = t16*t35;
+    let t46: f32 = ((4.0f*dx_3*x + 4.0f*dy_3*y) + (4.0f*dz_3*z + (-dx_2*t22 - dx_2*t23))) + ((-dy_2*t21 - dy_2*t23) + (-dz_2*t21 - dz_2*t22));
+    let t47: f32 = t26*t41 + t27*t40;
+    let t48: f32 = t25*t42 + (t28*t39 + t47*t7);
+    let t49: f32 = 11.090169943749475f*t32_2;
+    let t50: f32 = 2.0f*dx_2;
+    let t51: f32 = (-dy_2*t50 - dz_2*t50) + ((dx_4 + dy_4) + (-2.0f*dy_2*dz_2 + dz_4));
+    let t52: f32 = t40*t41;
+    let t53: f32 = t39*t42 + (t25*t47 + t52*t7);
+    let t54: f32 = t25*t52 + t39*t47;
+    let t55: f32 = t39*t52;
+    let c0: f32 = t11*t6 + t1_2*t3;
+    let c1: f32 = (t1*t20 + t18*t1_2) + (t11*t24 + t29*t6);
+    let c2: f32 = (t3*t34 + t43*t6) + ((t1*t31 + t11*t38) + (t1_2*t35 + t24*t29));
+    let c3: f32 = (t48*t6 + (t11*t46 + t18*t34)) + ((t24*t43 + t33*t45) + (t29*t38 + (t1_2*t44 + t20*t32)));
+    let c4: f32 = ((t24*t48 + (t1*t30*t32 + t3*t32_2)) + (t38*t43 + t53*t6)) + ((t29*t46 + (t11*t51 + t1_2*t49)) + (t31*t32 + t34*t35));
+    let c5: f32 = ((t24*t53 + t38*t48) + (2.0f*t32*t45 + t43*t46)) + ((t29*t51 + t34*t44) + (t54*t6 + (t1*t19*t32_2 + t18*t32_2)));
+    let c6: f32 = (t46*t48 + (t24*t54 + t32_2*t35)) + ((t34*t49 + (t30*t32_2 + t55*t6)) + (t38*t53 + t43*t51));
+    let c7: f32 = (t38*t54 + t46*t53) + (t48*t51 + (44.3606797749979f*t16*t32_3 + t24*t55));
+    let c8: f32 = (11.090169943749475f*t32_4 + t38*t55) + (t46*t54 + t51*t53);
+    let c9: f32 = t46*t55 + t51*t54;
+    let c10: f32 = t51*t55;
+    return Ray(oc, rd, sm, c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10);
 }
 
 // What the method evaluates at a march point s: (F, F', X), X its extra value. s is
 // s0 + h, the step's start plus its length (clamped): the point is (o + s0 d) + h d.
 fn values_at(ray: Ray, s: f32, s0: f32, h: f32) -> vec3<f32> {
-    let e0: vec3<f32> = SDH((ray.o + s0*ray.d) + h*ray.d, ray.d);
-    return vec3<f32>(e0.x, e0.y, e0.z);
+    let e0: vec2<f32> = ray_DH(ray, s);
+    let e1: f32 = S((ray.o + s0*ray.d) + h*ray.d);
+    return vec3<f32>(e1, e0.x, e0.y);
 }
 
 // (F, F') at s, for the refinement.
 fn fd(ray: Ray, s: f32) -> vec2<f32> {
-    let e0: vec2<f32> = SD(ray.o + s*ray.d, ray.d);
-    return vec2<f32>(e0.x, e0.y);
+    let e0: f32 = ray_dS(ray, s);
+    let e1: f32 = S(ray.o + s*ray.d);
+    return vec2<f32>(e1, e0);
 }
 
 // The step length at s, from the sample f0 there.
