@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import sympy
 
-from .derive import Derivatives, polynomial_degree
+from .derive import Derivatives, current_max_derived, polynomial_degree
 from .emit import build_functions, function_quantities
 from .marcher import choose_form, evaluations, step_ops
-from .methods import Method
+from .methods import Constants, Method
+from .pieces import build_programs
 from .raypoly import HORNER_ABOVE, coefficient_program, coefficient_route, ray_quantity_ops
-from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES
+from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, estrin_ops, walk_cost
 from .surface import Surface
 from .textform import to_text, value_text
 
@@ -82,8 +83,7 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
             f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
             f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries), "
             + ROUTES[coefficient_route(surface.expr)],
-            *_solver_lines(degree),
-            "  F by Estrin's scheme where its sign is certain, else S at the point",
+            *_solver_lines(surface.expr, degree, coefficients.ops_after),
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
@@ -115,14 +115,41 @@ def _short(expr: sympy.Expr, limit: int = 200) -> str:
     return text if len(text) <= limit else text[:limit] + " ..."
 
 
-def _solver_lines(degree: int) -> list[str]:
-    """The exact solver's strategy at this degree and its work per node or level."""
-    if degree >= BERNSTEIN_FROM:
-        shift = degree * (degree + 1) // 2
-        return [f"  strategy: Bernstein subdivision (degree >= {BERNSTEIN_FROM}): per node a "
-                f"Taylor shift ({shift} multiply-adds), {degree} scalings and {degree} "
-                f"Bernstein sums; 2-6 nodes a ray on average (measured), at most "
-                f"{BERNSTEIN_MAX_NODES}; "
-                "Newton on F with F' by Estrin's scheme"]
-    return [f"  strategy: critical points level by level (degree < {BERNSTEIN_FROM}): "
-            f"derivatives P1..P{degree - 1} of F by Estrin's scheme"]
+def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int) -> list[str]:
+    """The exact solver's strategy at this degree, its work per node or level, and (for
+    the Bernstein walk) the operations a ray costs."""
+    s_ops = build_programs(expr, (("S",),), current_max_derived())["S"].ops_after
+    if degree < BERNSTEIN_FROM:
+        # F (P_n): Estrin's value and S at the point, both computed; a Newton or Halley
+        # iteration reads F, F' and F''
+        f = estrin_ops(degree, 0) + s_ops + 6
+        step = f + sum(estrin_ops(degree, m) for m in (1, 2) if m < degree)
+        # the quartic's one loop solves F's root and an extremum: 2 x NEWTON_STEPS + 1
+        steps = Constants().newton_steps
+        cap = 2 * steps + 1 if degree == 4 else steps
+        return [f"  strategy: critical points level by level (degree < {BERNSTEIN_FROM}): "
+                f"derivatives P1..P{degree - 1} of F by Estrin's scheme, F by Estrin's "
+                "scheme where its sign is certain, else S at the point",
+                f"  per ray, about {coefficient_ops} + iterations x {step} operations (F, F' "
+                f"and F'' at a Newton or Halley iteration): {coefficient_ops + 5 * step:,} at "
+                f"5 iterations, {coefficient_ops + cap * step:,} at {cap}, the bound"
+                + (" of each of up to 3 rounds" if degree == 4 else "")]
+    cost = walk_cost(degree, s_ops)
+    node = cost.node + cost.node_end
+
+    def per_ray(nodes: int, steps: int) -> str:
+        total = coefficient_ops + cost.node_end + nodes * node + steps * cost.newton_step
+        return f"{total:,} at {nodes} nodes and {steps} Newton steps"
+
+    return [
+        f"  strategy: Bernstein subdivision (degree >= {BERNSTEIN_FROM}): per node a Taylor "
+        f"shift ({degree * (degree + 1) // 2} multiply-adds), {degree} scalings, the "
+        f"Bernstein sums and the sign changes ({cost.node} operations) and F at the node's "
+        f"end (S at the point, {cost.node_end}); then Newton, F "
+        f"{'at the point' if degree < ROBUST_NEWTON_BELOW else 'by Estrin'} and F' by "
+        f"Estrin's scheme, {cost.newton_step} a step",
+        f"  per ray, about {coefficient_ops} + {cost.node_end} + nodes x {node} + Newton "
+        f"steps x {cost.newton_step} operations: {per_ray(2, 5)}, {per_ray(6, 5)} "
+        f"(measured: 2-6 nodes a ray on average, at most {BERNSTEIN_MAX_NODES}; 4.5 Newton "
+        "steps a hit pixel at degree 18)",
+    ]

@@ -13,6 +13,7 @@ import sympy
 from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
+from .optimize import count_ops
 from .options import EXACT_MAX_DEGREE
 from .pieces import (
     Marcher,
@@ -213,12 +214,6 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
     beta_(n-i),k = (-1)^k beta_ik: the even part (k even) and the odd part are summed once
     for i <= n/2 and give b_i and b_(n-i) by a sum and a difference. With each let, the
     j of every pair (b_(j-1), b_j) whose sign change can be counted after it."""
-    e = [sym(f"e{k}") for k in range(n + 1)]
-
-    def beta(i: int, k: int) -> sympy.Rational:
-        return sympy.Rational(sum(comb(i, j) * comb(n - i, k - j) * (-1) ** (k - j)
-                                  for j in range(k + 1)), comb(n, k))
-
     lets: list[tuple[str, str, tuple[int, ...]]] = []
     known: set[int] = set()
 
@@ -228,13 +223,57 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
         lets.append((f"b{i}", value, tuple(j for j in (i, i + 1)
                                             if j - 1 in known and j in known)))
 
-    for i in range(n // 2 + 1):
-        even = sympy.Add(*(beta(i, k) * e[k] for k in range(0, n + 1, 2)))
-        odd = sympy.Add(*(beta(i, k) * e[k] for k in range(1, n + 1, 2)))
-        if 2 * i == n:  # the middle coefficient: its odd part is 0
+    for i, even, odd in bernstein_sums(n):
+        if odd is None:  # the middle coefficient
             coefficient(i, printer.doprint(even))
             continue
         lets += [(f"be{i}", printer.doprint(even), ()), (f"bo{i}", printer.doprint(odd), ())]
         coefficient(i, f"be{i} + bo{i}")
         coefficient(n - i, f"be{i} - bo{i}")
     return tuple(lets)
+
+
+def bernstein_sums(n: int) -> list[tuple[int, sympy.Expr, sympy.Expr | None]]:
+    """(i, even part, odd part) of b_i for i <= n/2 (bernstein_lets); the middle
+    coefficient of an even degree has no odd part (None)."""
+    e = [sym(f"e{k}") for k in range(n + 1)]
+
+    def beta(i: int, k: int) -> sympy.Rational:
+        return sympy.Rational(sum(comb(i, j) * comb(n - i, k - j) * (-1) ** (k - j)
+                                  for j in range(k + 1)), comb(n, k))
+
+    sums = []
+    for i in range(n // 2 + 1):
+        even = sympy.Add(*(beta(i, k) * e[k] for k in range(0, n + 1, 2)))
+        odd = sympy.Add(*(beta(i, k) * e[k] for k in range(1, n + 1, 2)))
+        sums.append((i, even, None if 2 * i == n else odd))
+    return sums
+
+
+@dataclass(frozen=True)
+class WalkCost:
+    """Operations of the Bernstein walk's parts (arithmetic only, as templates/solver.j2
+    prints them), for `implc show`'s per-ray estimate."""
+
+    node: int  # Taylor shift, scaling, Bernstein sums, sign changes
+    node_end: int  # F's robust value at a node's end: S at the point
+    newton_step: int  # F (Estrin's, or S at the point below ROBUST_NEWTON_BELOW) and F'
+
+
+def walk_cost(n: int, s_ops: int) -> WalkCost:
+    """WalkCost of a degree-n walk whose S costs `s_ops` at a point."""
+    shift = n * (n + 1)  # n(n + 1)/2 multiply-adds
+    scaling = 2 * n - 1
+    sums = sum(count_ops(even) + (count_ops(odd) + 2 if odd is not None else 0)
+               for _, even, odd in bernstein_sums(n))
+    signs = 2 * n  # a product and a comparison for each neighbouring pair
+    at_point = s_ops + 6  # S at o + u d
+    f = at_point if n < ROBUST_NEWTON_BELOW else estrin_ops(n, 0)
+    return WalkCost(shift + scaling + sums + signs, at_point, f + estrin_ops(n, 1))
+
+
+def estrin_ops(n: int, m: int) -> int:
+    """Operations of F^(m) of a degree-n ray polynomial by Estrin's scheme, its powers of
+    u included (`implc show`)."""
+    value, powers = estrin_derivative(n, m, sym("u"))
+    return count_ops(value) + sum(count_ops(v) for _, v in powers)

@@ -53,6 +53,30 @@ def test_show_reports_op_counts():
     proc = implc("show", "cross-cap")  # the default method for a quartic: exact
     assert proc.returncode == 0, proc.stderr
     assert "exact (root isolation" in proc.stdout
+    assert "per ray, about 55 + iterations x " in proc.stdout  # the coefficients' 55
+
+
+def test_show_estimates_the_bernstein_walk_per_ray():
+    """`implc show` of exact from degree 5: the walk's parts and the operations a ray costs,
+    its totals the sum of those parts."""
+    import re
+
+    proc = implc("show", "-e", "x^18 + y^18 + z^18 = 1")
+    assert proc.returncode == 0, proc.stderr
+    assert "Bernstein subdivision" in proc.stdout
+    assert "Taylor shift (171 multiply-adds)" in proc.stdout  # 18 * 19 / 2
+    found = re.search(r"per ray, about (\d+) \+ (\d+) \+ nodes x (\d+) \+ Newton steps x "
+                      r"(\d+) operations: ([\d,]+) at 2 nodes and 5 Newton steps, ([\d,]+) at 6 "
+                      r"nodes", proc.stdout)
+    assert found, proc.stdout
+    coefficients, start, node, step, two, six = (int(g.replace(",", ""))
+                                                 for g in found.groups())
+    assert coefficients == 243  # the ray coefficients' program, printed above
+    assert two == coefficients + start + 2 * node + 5 * step
+    assert six == coefficients + start + 6 * node + 5 * step
+    # a node: the shift's 342 operations, 35 scalings, 36 for the sign changes, the
+    # Bernstein sums, and S at the point (21 operations, printed above) plus the point
+    assert node > 342 + 35 + 36 + 21 + 6
 
 
 def test_compile_to_stdout_and_file(tmp_path):
