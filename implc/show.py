@@ -133,7 +133,7 @@ def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int) -> list[s
                 f"  per ray, about {coefficient_ops} + iterations x {step} operations (F, F' "
                 f"and F'' at a Newton or Halley iteration): {coefficient_ops + 5 * step:,} at "
                 f"5 iterations, {coefficient_ops + cap * step:,} at {cap}, the bound"
-                + (" of each of up to 3 rounds" if degree == 4 else "")]
+                + (f" of each of up to {degree - 1} rounds" if degree == 4 else "")]
     cost = walk_cost(degree, s_ops)
     node = cost.node + cost.node_end
 
