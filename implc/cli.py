@@ -45,6 +45,7 @@ from .fileio import (
 from .interrupts import Terminated, dropped_signals_kept, raise_dropped
 from .limits import Limits
 from .options import (
+    AUTO_RAY_POLY_MAX_DEGREE,
     EVAL_CHOICES,
     EXACT_MAX_DEGREE,
     METHOD_NAMES,
@@ -586,8 +587,9 @@ def _method_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--eval", choices=EVAL_CHOICES, help=(
         "how F, F', F'' are computed along a ray: point (3-D functions of p = o + s d), "
         "ray-poly (polynomial S: the ray polynomial's coefficients once per ray, then "
-        "Estrin's scheme), auto (default: of the two, the one whose march step evaluates "
-        "fewer operations; `implc show` prints both); see README \"Evaluation forms\""))
+        "Estrin's scheme), auto (default: ray-poly up to degree "
+        f"{AUTO_RAY_POLY_MAX_DEGREE} where its march step evaluates fewer operations, as "
+        "`implc show` prints, else point); see README \"Evaluation forms\""))
 
 
 # Every field of implc.limits.Limits, as the option its error messages name.

@@ -49,7 +49,7 @@ from .methods import (
     constant_values,
 )
 from .optimize import arrange_by_depth
-from .options import EVAL_CHOICES, EXACT_MAX_DEGREE
+from .options import AUTO_RAY_POLY_MAX_DEGREE, EVAL_CHOICES, EXACT_MAX_DEGREE
 from .pieces import (
     COMPONENT,
     QUANTITY_ORDER,
@@ -72,7 +72,7 @@ from .raypoly import (
 )
 from .solver import check_exact, lower_solver
 
-# EVAL_CHOICES is plain data in implc/options.py
+# EVAL_CHOICES and AUTO_RAY_POLY_MAX_DEGREE (`auto`'s bound) are plain data in implc/options.py
 
 # When the root test's inputs are ready, in operations (optimize.arrange_by_depth): the
 # start sample (F0, F0', X0) first (depth 0), then the step length h, after the step rule,
@@ -100,8 +100,9 @@ def choose_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> st
     """The evaluation form `method`'s shader for `expr` uses when `requested` is asked (as
     `lower` prints it; what a render's sidecar records): the exact solver works on the ray
     polynomial, the interval method at points. A marcher takes what is asked, and under
-    `auto` the form whose march step evaluates fewer operations (step_ops): measured,
-    the faster one on every surface timed in both forms (docs/RESULTS.md section 2)."""
+    `auto` ray-poly where its march step evaluates fewer operations (step_ops) and the
+    degree is at most AUTO_RAY_POLY_MAX_DEGREE (where it measured as accurate), else point:
+    the faster form on every surface timed in both (docs/RESULTS.md section 2)."""
     if requested not in EVAL_CHOICES:
         raise InputError(f"unknown evaluation form '{requested}'; choose from "
                          f"{', '.join(EVAL_CHOICES)}")
@@ -115,6 +116,8 @@ def choose_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> st
         return "point"
     if requested != "auto":
         return requested
+    if degree > AUTO_RAY_POLY_MAX_DEGREE:
+        return "point"
     cheaper = step_ops(method, expr, "ray-poly") < step_ops(method, expr, "point")
     return "ray-poly" if cheaper else "point"
 

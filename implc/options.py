@@ -1,6 +1,6 @@
 """What the command line offers, as plain data: the method names, the marcher's
-constants, the evaluation forms (`auto`'s rule is implc/marcher.py's choose_form) and the
-exact method's degree bound.
+constants, the evaluation forms and `auto`'s degree bound (its rule is implc/marcher.py's
+choose_form), and the exact method's degree bound.
 
 No sympy or numpy here, so that `implc --help`, `implc COMMAND --help` and `--version`
 start in a fraction of the time the registries take to import (`make startup`). The
@@ -18,6 +18,13 @@ METHOD_NAMES = ("sign", "taylor", "curvature", "hessian", "hessian-approx", "exa
 # Evaluation forms (implc/marcher.py): how F, F', F'' are computed along a ray.
 FORMS = ("point", "ray-poly")
 EVAL_CHOICES = ("auto", *FORMS)
+# `auto` takes ray-poly only up to this degree (where its march step is also the cheaper,
+# implc/marcher.py choose_form): up to degree 12 its false / missed / wrong-root counts
+# measured those of point evaluation to a few pixels (bundled polynomials, the sweeps,
+# corpus rows 137, 163, 244 and 285 at 512^2), but on the degree-14 knot of corpus row 247
+# F' and F'' from the ray's coefficients made taylor 1,850 / 0 / 657 against point's
+# 309 / 0 / 75, and hessian 1,398 / 0 / 497 against 58 / 0 / 3 (docs/RESULTS.md section 2)
+AUTO_RAY_POLY_MAX_DEGREE = 12
 
 # The exact method's highest degree. Float32 root isolation through the expanded ray
 # polynomial loses accuracy with the degree and the coefficients' size; measured at 512^2

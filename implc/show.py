@@ -8,6 +8,7 @@ from .derive import Derivatives, current_max_derived, polynomial_degree
 from .emit import build_functions, function_quantities
 from .marcher import choose_form, evaluations, step_ops
 from .methods import Constants, Method
+from .options import AUTO_RAY_POLY_MAX_DEGREE
 from .pieces import build_programs
 from .raypoly import HORNER_ABOVE, coefficient_program, coefficient_route, ray_quantity_ops
 from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, estrin_ops, walk_cost
@@ -95,7 +96,9 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
     return [
         "",
         f"per march step: point form {costs['point']} ops, ray-poly form "
-        f"{costs['ray-poly']} ops; --eval auto takes {choose_form(method, surface.expr)}",
+        f"{costs['ray-poly']} ops; --eval auto takes {choose_form(method, surface.expr)}"
+        + (f" (ray-poly only up to degree {AUTO_RAY_POLY_MAX_DEGREE}, where it measured as "
+           "accurate)" if degree > AUTO_RAY_POLY_MAX_DEGREE else ""),
         "ray-poly form:",
         f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
         f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries)",

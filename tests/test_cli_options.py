@@ -348,3 +348,24 @@ def test_auto_takes_the_form_whose_march_step_costs_less(spec, method, form):
     assert choose_form(meth, surface.expr) == form
     assert emit(surface, "glsl", method) == emit(surface, "glsl", method, evaluation=form)
     assert emit(surface, "glsl", method) != emit(surface, "glsl", method, evaluation=other)
+
+
+def test_auto_keeps_point_above_its_degree_bound():
+    """Above AUTO_RAY_POLY_MAX_DEGREE `auto` takes point even where ray-poly's step is the
+    cheaper (Chmutov's T14: 101 against 125 operations): on the degree-14 knot F' and F''
+    from the ray's coefficients multiplied taylor's and hessian's bad pixels."""
+    import sympy
+
+    from implc.marcher import choose_form, step_ops
+    from implc.methods import METHODS
+    from implc.options import AUTO_RAY_POLY_MAX_DEGREE
+    from implc.surface import load_surface
+
+    for degree in (AUTO_RAY_POLY_MAX_DEGREE, AUTO_RAY_POLY_MAX_DEGREE + 2):
+        t = sympy.Poly(sympy.chebyshevt(degree, sympy.Symbol("x")))
+        equation = " + ".join(f"({c})*{v}^{k}" for (k,), c in t.terms() for v in "xyz")
+        expr = load_surface(equation=equation).expr
+        taylor = METHODS["taylor"]
+        assert step_ops(taylor, expr, "ray-poly") < step_ops(taylor, expr, "point")
+        expected = "ray-poly" if degree <= AUTO_RAY_POLY_MAX_DEGREE else "point"
+        assert choose_form(taylor, expr) == expected, degree

@@ -54,12 +54,13 @@ def test_the_light_tables_are_the_registries():
     """What the command line offers without importing the registries (implc/options.py)
     is what the registries hold."""
     from implc.backends.opencl import PRECISIONS
-    from implc.marcher import EVAL_CHOICES
+    from implc.marcher import AUTO_RAY_POLY_MAX_DEGREE, EVAL_CHOICES
     from implc.methods import METHODS
+    from implc.options import AUTO_RAY_POLY_MAX_DEGREE as LIGHT_AUTO
     from implc.options import EVAL_CHOICES as LIGHT_EVAL
     from implc.options import METHOD_NAMES
     from implc.targets import TARGETS
 
     assert tuple(METHODS) == METHOD_NAMES
-    assert EVAL_CHOICES == LIGHT_EVAL
+    assert (EVAL_CHOICES, AUTO_RAY_POLY_MAX_DEGREE) == (LIGHT_EVAL, LIGHT_AUTO)
     assert TARGETS["opencl"].precisions == PRECISIONS
