@@ -238,13 +238,23 @@ def ray_quantity_ops(n: int, quantity: str) -> int:
     factors on them included, the coefficients taken as given (`implc show`)."""
     m = DERIVATIVE_ORDER[quantity]
     weights = weighted_coefficients(n, m)[1] if n >= m else [1]
-    value, powers = estrin([sym(f"a{k}") for k in range(len(weights))], sym("s"), weights)
-    return count_ops(value) + sum(count_ops(v) for _, v in powers)
+    return _chain_ops(*estrin([sym(f"a{k}") for k in range(len(weights))], sym("s"), weights))
 
 
 def estrin_derivative(n: int, m: int, x: sympy.Symbol):
     """F^(m) at x by Estrin's scheme: (value, the lets of its powers of x)."""
     return estrin(derivative_coefficients(n, m), x)
+
+
+def estrin_derivative_ops(n: int, m: int) -> int:
+    """Operations of F^(m) of a degree-n ray polynomial by Estrin's scheme (the exact
+    solver's P_k), its powers of u included (`implc show`)."""
+    return _chain_ops(*estrin_derivative(n, m, sym("u")))
+
+
+def _chain_ops(value: sympy.Expr, powers) -> int:
+    """Operations of an Estrin chain: its value and the lets of its powers."""
+    return count_ops(value) + sum(count_ops(v) for _, v in powers)
 
 
 def weighted_coefficients(n: int, m: int) -> tuple[list[sympy.Expr], list[int]]:

@@ -10,8 +10,14 @@ from .marcher import choose_form, evaluations, step_ops
 from .methods import Constants, Method
 from .options import AUTO_RAY_POLY_MAX_DEGREE
 from .pieces import build_programs
-from .raypoly import HORNER_ABOVE, coefficient_program, coefficient_route, ray_quantity_ops
-from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, estrin_ops, walk_cost
+from .raypoly import (
+    HORNER_ABOVE,
+    coefficient_program,
+    coefficient_route,
+    estrin_derivative_ops,
+    ray_quantity_ops,
+)
+from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, walk_cost
 from .surface import Surface
 from .textform import to_text, value_text
 
@@ -125,8 +131,8 @@ def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int) -> list[s
     if degree < BERNSTEIN_FROM:
         # F (P_n): Estrin's value and S at the point, both computed; a Newton or Halley
         # iteration reads F, F' and F''
-        f = estrin_ops(degree, 0) + s_ops + 6
-        step = f + sum(estrin_ops(degree, m) for m in (1, 2) if m < degree)
+        f = estrin_derivative_ops(degree, 0) + s_ops + 6
+        step = f + sum(estrin_derivative_ops(degree, m) for m in (1, 2) if m < degree)
         # the quartic's one loop solves F's root and an extremum: 2 x NEWTON_STEPS + 1
         steps = Constants().newton_steps
         cap = 2 * steps + 1 if degree == 4 else steps

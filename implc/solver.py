@@ -30,6 +30,7 @@ from .raypoly import (
     derivative_coefficients,
     estrin,
     estrin_derivative,
+    estrin_derivative_ops,
     from_ray,
     horner,
     ray_setup,
@@ -268,12 +269,5 @@ def walk_cost(n: int, s_ops: int) -> WalkCost:
                for _, even, odd in bernstein_sums(n))
     signs = 2 * n  # a product and a comparison for each neighbouring pair
     at_point = s_ops + 6  # S at o + u d
-    f = at_point if n < ROBUST_NEWTON_BELOW else estrin_ops(n, 0)
-    return WalkCost(shift + scaling + sums + signs, at_point, f + estrin_ops(n, 1))
-
-
-def estrin_ops(n: int, m: int) -> int:
-    """Operations of F^(m) of a degree-n ray polynomial by Estrin's scheme, its powers of
-    u included (`implc show`)."""
-    value, powers = estrin_derivative(n, m, sym("u"))
-    return count_ops(value) + sum(count_ops(v) for _, v in powers)
+    f = at_point if n < ROBUST_NEWTON_BELOW else estrin_derivative_ops(n, 0)
+    return WalkCost(shift + scaling + sums + signs, at_point, f + estrin_derivative_ops(n, 1))
