@@ -47,6 +47,8 @@ def test_baseline_does_the_generated_programs_work(key, method):
     m = compare(hand, reference)
     if METHODS[method].solves:  # exact root isolation, as the generated program's
         assert m["false_hits"] <= 1 and m["missed_hits"] + m["wrong_root"] <= 2, m
+        # the same walk: the same nodes a ray (both count them in aux.z)
+        assert abs(hand.steps.mean() - generated.steps.mean()) <= 0.01 * generated.steps.mean()
     elif BASELINES[key, method]:  # Eq. 4: no false roots on the self-intersection
         assert m["false_hits"] <= 1, m
     else:  # Eq. 3 draws the false-root "stick"
