@@ -1047,7 +1047,7 @@ def cmd_compare(args) -> int:
     import json
 
     from .compare import compare_files, format_metrics
-    from .metrics import T_TOL
+    from .options import T_TOL
 
     t_tol = T_TOL if args.t_tol is None else args.t_tol  # its type checks the range
     metrics = compare_files(args.a, args.b, t_tol)

@@ -44,7 +44,7 @@ def locate_surface(expr: sympy.Expr, center: Vec3 | None = None) -> Extent | Non
     origin = np.zeros(3) if center is None else np.asarray(center, dtype=np.float64)
     first_found = None
     for half in GROWING:
-        points, spacing, touching = _sign_changes(expr, origin, half)
+        points, spacing, touching = sign_changes(expr, origin, half)
         if len(points) and not touching:
             return _bounded(expr, points, spacing, center)
         if len(points) and first_found is None:
@@ -52,7 +52,7 @@ def locate_surface(expr: sympy.Expr, center: Vec3 | None = None) -> Extent | Non
     if first_found is not None:  # unbounded: the first cube that holds a piece of it
         return Extent(_vec3(origin), first_found, bounded=False)
     for half in SHRINKING:
-        points, spacing, _ = _sign_changes(expr, origin, half)
+        points, spacing, _ = sign_changes(expr, origin, half)
         if len(points):
             return _bounded(expr, points, spacing, center)
     return None
@@ -67,7 +67,7 @@ def _bounded(expr: sympy.Expr, points: np.ndarray, spacing: float,
     """Sample again in a cube tight around the sign changes found, then the sphere."""
     low, high = points.min(axis=0) - 2 * spacing, points.max(axis=0) + 2 * spacing
     middle = (low + high) / 2.0
-    fine, fine_spacing, _ = _sign_changes(expr, middle, float((high - low).max()) / 2.0)
+    fine, fine_spacing, _ = sign_changes(expr, middle, float((high - low).max()) / 2.0)
     if len(fine):
         points, spacing = fine, fine_spacing
     if center is None:
@@ -89,7 +89,7 @@ def _quantum(length: float) -> float:
     return 10.0 ** (math.floor(math.log10(max(length, 1e-12))) - 1)
 
 
-def _sign_changes(expr: sympy.Expr, center: np.ndarray,
+def sign_changes(expr: sympy.Expr, center: np.ndarray,
                   half: float) -> tuple[np.ndarray, float, bool]:
     """(points where S changes sign along a grid edge, the grid spacing, whether any of
     them lies in the cube's outer layer of cells) for the cube of half-size `half`."""

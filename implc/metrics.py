@@ -5,15 +5,8 @@ from __future__ import annotations
 import numpy as np
 from skimage.metrics import structural_similarity
 
+from .options import T_TOL
 from .render.result import RenderResult
-
-# Default wrong-root tolerance on t, absolute, in scene units (the paper's surfaces fit in a
-# clip sphere of radius ~1.5). A float32 marcher refined by 10 Newton-bisection steps lands
-# within ~1e-4 of the root it bracketed (float32 t near 5 is itself only good to ~5e-7,
-# and a near-double root is conditioned like sqrt of that); a different root is typically
-# >= 1e-2 away at the step sizes b = 0.002..0.01. 1e-3 sits between the two by an order of
-# magnitude on each side.
-T_TOL = 1e-3
 
 
 def compare(a: RenderResult, ref: RenderResult, t_tol: float = T_TOL) -> dict:

@@ -35,6 +35,8 @@ def describe(surface: Surface, method: Method) -> str:
     if surface.params:
         lines.append("params:    " + ", ".join(f"{k} = {value_text(v)}"
                                                for k, v in surface.params.items()))
+    if degree is not None:
+        lines += _float32_lines(surface.expr)
     lines += [
         "",
         "derived (point form: p = (x, y, z), unit ray direction D = (dx, dy, dz)):",
@@ -62,6 +64,24 @@ def describe(surface: Surface, method: Method) -> str:
         lines += _interval_lines(surface)
     lines += _ray_poly_counts(surface, method, degree)
     return "\n".join(lines)
+
+
+def _float32_lines(expr: sympy.Expr) -> list[str]:
+    """How far float32 rounding of S moves the surface (implc/conditioning.py)."""
+    from .conditioning import WARN_SHARE, float32_conditioning
+    from .options import T_TOL
+
+    c = float32_conditioning(expr)
+    if c is None:
+        return ["float32:   not measured (S is not a polynomial in x, y, z as written, or it "
+                "changes sign nowhere framing samples)"]
+    lines = [f"float32:   a rounding of S moves the surface by {c.median:.1e} (median), "
+             f"{c.p90:.1e} (p90) at {c.points:,} sampled points; {100 * c.far:.1f} % move "
+             f"more than {T_TOL:g}, the distance the counts call a wrong root"]
+    if c.far >= WARN_SHARE:
+        lines.append("           warning: float32 cannot hold this surface: expect wrong "
+                     "pixels from every method (exact's ray polynomial rounds worse still)")
+    return lines
 
 
 def _interval_lines(surface: Surface) -> list[str]:

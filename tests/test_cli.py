@@ -79,6 +79,42 @@ def test_show_estimates_the_bernstein_walk_per_ray():
     assert node > 342 + 35 + 36 + 21 + 6
 
 
+def test_show_measures_how_far_float32_moves_the_surface():
+    """`implc show` of a polynomial says how far a float32 rounding of S moves its surface
+    (implc/conditioning.py): on Chmutov's T_18 + T_18 + T_18 (coefficients up to 2^17
+    against values of order 1) half the sampled points move more than the counts'
+    wrong-root distance, and it warns; on x^18 + y^18 + z^18 = 1 none does."""
+    import sympy
+
+    x = sympy.Symbol("x")
+    t18 = sympy.Poly(sympy.chebyshevt(18, x), x)
+    chmutov = " + ".join(f"({c})*{v}^{k}" for (k,), c in t18.terms() for v in "xyz")
+    share = r"([\d.]+) % move more than 0.001"
+    proc = implc("show", "-e", chmutov + " = 0")
+    assert proc.returncode == 0, proc.stderr
+    assert float(re.search(share, proc.stdout).group(1)) > 25, proc.stdout
+    assert "warning: float32 cannot hold this surface" in proc.stdout
+    proc = implc("show", "-e", "x^18 + y^18 + z^18 = 1")
+    assert proc.returncode == 0, proc.stderr
+    assert float(re.search(share, proc.stdout).group(1)) == 0.0, proc.stdout
+    assert "warning: float32" not in proc.stdout
+
+
+def test_magnitude_is_s_without_cancellation():
+    """M, the size of S's terms as written: constants by their absolute values,
+    subtractions as additions; None for what is not a polynomial tree."""
+    import sympy
+
+    from implc.conditioning import magnitude
+    from implc.symbols import POINT
+
+    x, y, z = POINT
+    assert magnitude(x - 2 * y * z) == x + 2 * y * z
+    assert magnitude(-(x - 1) ** 2) == (x + 1) ** 2
+    assert magnitude(-sympy.sqrt(2) * x) == sympy.sqrt(2) * x
+    assert magnitude(x / y) is None
+
+
 def test_compile_to_stdout_and_file(tmp_path):
     proc = implc("compile", "cross-cap", "-m", "taylor")
     assert proc.returncode == 0, proc.stderr
