@@ -5,7 +5,7 @@ Evaluated in float32, S at a point is off by up to about 2^-24 times the sum of 
 terms' magnitudes, M(p) (S as written, every constant and coordinate by its absolute
 value, every subtraction an addition). Near the surface that error moves the zero set
 by about d(p) = 2^-24 M(p) / |grad S(p)|. Where d reaches the distance the counts call
-a wrong root (metrics.T_TOL), no float32 method can draw the surface right there, and
+a wrong root (options.T_TOL), no float32 method can draw the surface right there, and
 the exact method's ray polynomial, an expansion about the chord's middle, rounds worse
 still. Measured (docs/RESULTS.md section 8): on Chmutov's T_n + T_n + T_n the share of
 points moved beyond T_TOL is 0 up to degree 14, 1.3 % at 16, 52 % at 18 and 66 % at 20,

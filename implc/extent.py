@@ -90,7 +90,7 @@ def _quantum(length: float) -> float:
 
 
 def sign_changes(expr: sympy.Expr, center: np.ndarray,
-                  half: float) -> tuple[np.ndarray, float, bool]:
+                 half: float) -> tuple[np.ndarray, float, bool]:
     """(points where S changes sign along a grid edge, the grid spacing, whether any of
     them lies in the cube's outer layer of cells) for the cube of half-size `half`."""
     spacing = 2.0 * half / GRID

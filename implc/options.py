@@ -86,9 +86,8 @@ TAYLOR2_CHOICES = ("paper", "consistent", "extremum")
 # The counts' wrong-root tolerance on t (metrics.compare; `implc compare --t-tol`; the
 # distance implc/conditioning.py measures against), absolute, in scene units (the paper's
 # surfaces fit in a clip sphere of radius ~1.5). A float32 marcher refined by 10
-# Newton-bisection steps lands
-# within ~1e-4 of the root it bracketed (float32 t near 5 is itself only good to ~5e-7,
-# and a near-double root is conditioned like sqrt of that); a different root is typically
-# >= 1e-2 away at the step sizes b = 0.002..0.01. 1e-3 sits between the two by an order of
-# magnitude on each side.
+# Newton-bisection steps lands within ~1e-4 of the root it bracketed (float32 t near 5 is
+# itself only good to ~5e-7, and a near-double root is conditioned like sqrt of that); a
+# different root is typically >= 1e-2 away at the step sizes b = 0.002..0.01. 1e-3 sits
+# between the two by an order of magnitude on each side.
 T_TOL = 1e-3
