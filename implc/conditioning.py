@@ -64,13 +64,16 @@ def magnitude(expr: sympy.Expr) -> sympy.Expr | None:
     return None
 
 
-def float32_conditioning(expr: sympy.Expr) -> Conditioning | None:
-    """The distances float32 rounding moves the surface of a polynomial S, at the sign
-    changes of S in the cube around its located extent; None when S is not a polynomial
-    tree or no surface is found."""
+def float32_conditioning(expr: sympy.Expr,
+                         gradient: tuple[sympy.Expr, ...]) -> Conditioning | None:
+    """The distances float32 rounding moves the surface of a polynomial S (its
+    `gradient`: derive.Derivatives'), at the sign changes of S in the cube around its
+    located extent; None when S is not a polynomial tree or no surface is found."""
     bound = magnitude(expr)
-    extent = None if bound is None else locate_surface(expr)
-    if bound is None or extent is None:
+    if bound is None:
+        return None
+    extent = locate_surface(expr)
+    if extent is None:
         return None
     points, _, _ = sign_changes(expr, np.asarray(extent.center, dtype=np.float64),
                                 extent.radius)
@@ -78,7 +81,7 @@ def float32_conditioning(expr: sympy.Expr) -> Conditioning | None:
         return None
     at = dict(zip(POINT, points.T, strict=True))
     size = evaluate(bound, dict(zip(POINT, np.abs(points.T), strict=True)))
-    slope = np.sqrt(sum(evaluate(sympy.diff(expr, v), at) ** 2 for v in POINT))
+    slope = np.sqrt(sum(evaluate(g, at) ** 2 for g in gradient))
     with np.errstate(divide="ignore", invalid="ignore"):
         moved = np.where(slope > 0, FLOAT32_UNIT * size / slope, np.inf)
     moved = np.broadcast_to(moved, (len(points),))

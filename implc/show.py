@@ -8,7 +8,7 @@ from .derive import Derivatives, current_max_derived, polynomial_degree
 from .emit import build_functions, function_quantities
 from .marcher import choose_form, evaluations, step_ops
 from .methods import Constants, Method
-from .options import AUTO_RAY_POLY_MAX_DEGREE
+from .options import AUTO_RAY_POLY_MAX_DEGREE, T_TOL
 from .pieces import build_programs
 from .raypoly import (
     HORNER_ABOVE,
@@ -36,7 +36,7 @@ def describe(surface: Surface, method: Method) -> str:
         lines.append("params:    " + ", ".join(f"{k} = {value_text(v)}"
                                                for k, v in surface.params.items()))
     if degree is not None:
-        lines += _float32_lines(surface.expr)
+        lines += _float32_lines(surface.expr, d.gradient)
     lines += [
         "",
         "derived (point form: p = (x, y, z), unit ray direction D = (dx, dy, dz)):",
@@ -66,12 +66,11 @@ def describe(surface: Surface, method: Method) -> str:
     return "\n".join(lines)
 
 
-def _float32_lines(expr: sympy.Expr) -> list[str]:
+def _float32_lines(expr: sympy.Expr, gradient: tuple[sympy.Expr, ...]) -> list[str]:
     """How far float32 rounding of S moves the surface (implc/conditioning.py)."""
     from .conditioning import WARN_SHARE, float32_conditioning
-    from .options import T_TOL
 
-    c = float32_conditioning(expr)
+    c = float32_conditioning(expr, gradient)
     if c is None:
         return ["float32:   not measured (S is not a polynomial in x, y, z as written, or it "
                 "changes sign nowhere framing samples)"]
