@@ -820,7 +820,8 @@ def _compile_target(args) -> str:
 def _check_shader_options(args, target: Target) -> None:
     """--flavor, --precision and --prefix against the target: a usage error (exit 2),
     before any work."""
-    if args.flavor is not None and (problem := flavor_problem(target, args.flavor)):
+    if args.flavor is not None and (
+            problem := flavor_problem(target, args.flavor, args.precision or "float")):
         raise UsageError(f"--flavor: {problem}")
     if args.precision is not None and args.precision not in target.precisions:
         others = [t.name for t in TARGETS.values() if args.precision in t.precisions]

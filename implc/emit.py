@@ -122,14 +122,14 @@ def emit(
     meth = get_method(method)
     constants = constants or meth.defaults
     flavor = flavor or tgt.default_flavor
-    problem = flavor_problem(tgt, flavor) or prefix_problem(prefix, tgt)
+    precision = precision or "float"
+    if precision not in tgt.precisions:
+        raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
+    problem = flavor_problem(tgt, flavor, precision) or prefix_problem(prefix, tgt)
     if problem:
         raise InputError(problem)
     if emit_form not in EMITS:
         raise InputError(f"unknown emit '{emit_form}'; choose from {', '.join(EMITS)}")
-    precision = precision or "float"
-    if precision not in tgt.precisions:
-        raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
     if params not in PARAM_MODES:
         raise InputError(f"unknown --params '{params}'; choose from {', '.join(PARAM_MODES)}")
     uniforms = param_uniforms(surface, target, emit_form, prefix) if params == "uniform" else []
@@ -150,6 +150,10 @@ def emit(
     label = meth.name + (f" (Eq. 4: {constants.taylor2})" if meth.reads_taylor2 else "")
     types = _types(tgt, precision, prefix)
     literals = {"zero": 0.0, "half": 0.5, "one": 1.0, "four": 4.0}
+    # the camera, the shading and the entry points: in the precision, or float (see
+    # Target.float_shading)
+    shade_precision = "float" if precision in tgt.float_shading else precision
+    shade_printer = tgt.make_printer(shade_precision)
     context = {
         "surface": {"name": surface.name, "equation": equation},
         "params": [{"name": u.name, "uniform": u.uniform, "offset": u.offset,
@@ -164,12 +168,14 @@ def emit(
         "lang": f"{tgt.name}/lang.j2",
         "types": types,
         "lit": {k: printer.float_literal(v) for k, v in literals.items()},
+        "shade_types": _types(tgt, shade_precision, prefix),
+        "shade_lit": {k: shade_printer.float_literal(v) for k, v in literals.items()},
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
         "flavor_name": flavor,
         "precision": precision,
-        "shading": print_shading(surface.view, printer),
-        "view": _print_view(surface.view, printer),
+        "shading": print_shading(surface.view, shade_printer),
+        "view": _print_view(surface.view, shade_printer),
     }
     template = environment(tgt.name).get_template(tgt.templates[emit_form])
     return template.render(context)
@@ -188,7 +194,7 @@ def render_template(name: str, **context) -> str:
 
 def _types(tgt, precision: str, prefix: str) -> dict:
     """The skeleton's abstract type names -> the target's spelling."""
-    real, vec2, vec3, vec4 = (t.replace("float", precision) for t in tgt.vector_types)
+    real, vec2, vec3, vec4 = tgt.vector_types[precision]
     return {"real": real, "vec2": vec2, "vec3": vec3, "vec4": vec4, "int": tgt.int_type,
             "bool": "bool",
             "Ray": prefix + "Ray", "Hit": prefix + "Hit", "Params": prefix + "Params"}

@@ -78,8 +78,10 @@ def _float32_lines(expr: sympy.Expr, gradient: tuple[sympy.Expr, ...]) -> list[s
              f"{c.p90:.1e} (p90) at {c.points:,} sampled points; {100 * c.far:.1f} % move "
              f"more than {T_TOL:g}, the distance the counts call a wrong root"]
     if c.far >= WARN_SHARE:
-        lines.append("           warning: float32 cannot hold this surface: expect wrong "
-                     "pixels from every method (exact's ray polynomial rounds worse still)")
+        lines += ["           warning: float32 cannot hold this surface: expect wrong "
+                  "pixels from every method (exact's ray polynomial rounds worse still)",
+                  "           in double it holds: --precision double (-t glsl, flavour 330 "
+                  "or 450, or -t opencl; render -b gl-double or cl-double)"]
     return lines
 
 

@@ -45,12 +45,15 @@ class Backend:
     probe: str = ""
 
 
-# GLSL flavour -> how the program form is framed (read by templates/glsl/program.glsl.j2)
+# GLSL flavour -> how the program form is framed (read by templates/glsl/program.glsl.j2).
+# `double`: how the flavour gets double precision (--precision double): "extension"
+# (GL_ARB_gpu_shader_fp64, which GLSL 330 needs), "core" (GLSL 4.00 on), or None (GLSL ES
+# and WebGL, hence Shadertoy, have no double).
 GLSL_FLAVORS = {
-    "330": {"version": "330 core", "es": False, "shadertoy": False},
-    "450": {"version": "450 core", "es": False, "shadertoy": False},
-    "es300": {"version": "300 es", "es": True, "shadertoy": False},
-    "shadertoy": {"version": "", "es": False, "shadertoy": True},
+    "330": {"version": "330 core", "es": False, "shadertoy": False, "double": "extension"},
+    "450": {"version": "450 core", "es": False, "shadertoy": False, "double": "core"},
+    "es300": {"version": "300 es", "es": True, "shadertoy": False, "double": None},
+    "shadertoy": {"version": "", "es": False, "shadertoy": True, "double": None},
 }
 
 
@@ -79,8 +82,14 @@ class Target:
     backends: Mapping[str, Backend]  # render backend name -> Backend
     flavors: Mapping[str, Mapping[str, object]] = field(default_factory=lambda: {"default": {}})
     default_flavor: str = "default"
-    precisions: tuple[str, ...] = ("float",)
-    vector_types: tuple[str, ...] = ("float", "vec2", "vec3", "vec4")  # templates' `types`
+    # precision -> the templates' `types` in it (real, vec2, vec3, vec4); the first is the
+    # default precision
+    vector_types: Mapping[str, tuple[str, ...]] = field(
+        default_factory=lambda: {"float": ("float", "vec2", "vec3", "vec4")})
+    # a precision whose built-ins lack pow and tan (GLSL's double): in it the camera, the
+    # shading and the drop-in entry points (march, intersect) stay float, and only the
+    # surface and its solver (S, grad, the ray record, trace) take the precision
+    float_shading: tuple[str, ...] = ()
     int_type: str = "int"  # the marcher's loop counters and step counts
     # how the functions of a `--params uniform` shader read the parameters: "global"
     # (uniforms, a uniform struct) or "argument" (a Params struct that every function
@@ -94,6 +103,11 @@ class Target:
     # the shader stages `implc validate --stage` may choose (a language with one kind of
     # file, a compute shader or a kernel, has none to choose)
     stages: tuple[str, ...] = ()
+
+    @property
+    def precisions(self) -> tuple[str, ...]:
+        """The precisions the target prints in, the default first."""
+        return tuple(self.vector_types)
 
     @property
     def compile_extensions(self) -> tuple[str, ...]:
@@ -120,9 +134,17 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         validator="implc.validate:validate_glsl",
         backends={"gl": Backend("implc.render.gl:open_gl_runner",
                                 "GLSL 330 on OpenGL (moderngl, EGL; llvmpipe here)",
-                                probe="implc.render.gl:context")},
+                                probe="implc.render.gl:context"),
+                  "gl-double": Backend("implc.render.gl:open_gl_double_runner",
+                                       "the same with the surface solved in double "
+                                       "(needs GL_ARB_gpu_shader_fp64)",
+                                       precision="double",
+                                       probe="implc.render.gl:double_context")},
         flavors=GLSL_FLAVORS,
         default_flavor="330",  # also the program the gl backend runs (render/gl.py)
+        vector_types={"float": ("float", "vec2", "vec3", "vec4"),
+                      "double": ("double", "dvec2", "dvec3", "dvec4")},
+        float_shading=("double",),
         # a library's uniforms are globals of the user's shader: they carry the prefix
         param_layout={"program": ParamLayout(),
                       "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
@@ -143,7 +165,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         # host writes it as bytes: render/wgpu_runner.py); a library's, of its Params
         param_layout={"program": ParamLayout(ref="u.{uniform}", offset=76),
                       "library": ParamLayout(ref="{prefix}params.{uniform}")},
-        vector_types=("f32", "vec2<f32>", "vec3<f32>", "vec4<f32>"),
+        vector_types={"float": ("f32", "vec2<f32>", "vec3<f32>", "vec4<f32>")},
         int_type="i32",
     ),
     Target(
@@ -162,10 +184,10 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
                                  "the same in double precision (needs cl_khr_fp64)",
                                  precision="double", probe="implc.devices:opencl_device"),
         },
-        # templates/opencl/ spell double/double2/double3 from `precision`; the printer
+        # templates/opencl/ also spell double/double3 from `precision`; the printer
         # checks the same names (backends/opencl.py PRECISIONS)
-        precisions=("float", "double"),
-        vector_types=("float", "float2", "float3", "float4"),
+        vector_types={"float": ("float", "float2", "float3", "float4"),
+                      "double": ("double", "double2", "double3", "double4")},
         params_read_as="argument",
         param_layout={"program": ParamLayout(ref="params.{uniform}"),
                       "library": ParamLayout(ref="params.{uniform}")},
@@ -181,7 +203,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
             "implc.render.hlsl_runner:open_hlsl_runner",
             "HLSL pixel shader through SPIR-V (glslang, spirv-cross) on OpenGL (llvmpipe)",
             probe="implc.render.hlsl_runner:toolchain")},
-        vector_types=("float", "float2", "float3", "float4"),
+        vector_types={"float": ("float", "float2", "float3", "float4")},
         param_layout={"program": ParamLayout(),
                       "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
     ),
@@ -200,9 +222,14 @@ def target_of_file(suffix: str) -> Target | None:
     return next((t for t in TARGETS.values() if suffix in t.extensions), None)
 
 
-def flavor_problem(target: Target, flavor: str) -> str | None:
-    """Why `flavor` is not one of `target`'s flavours, naming the choices (None: it is)."""
+def flavor_problem(target: Target, flavor: str, precision: str = "float") -> str | None:
+    """Why `flavor` is not one of `target`'s flavours, naming the choices, or cannot print
+    in `precision` (None: it is and it can)."""
     if flavor in target.flavors:
+        if precision == "double" and target.flavors[flavor].get("double", True) is None:
+            able = [f for f, v in target.flavors.items() if v.get("double", True)]
+            return (f"the {target.name} flavour {flavor} has no double precision: use "
+                    f"--precision double with {' or '.join(able)}")
         return None
     if len(target.flavors) == 1:
         having = " and ".join(t.name for t in TARGETS.values() if len(t.flavors) > 1)

@@ -94,7 +94,8 @@ def validate_glsl(text: str, name: str = "shader.frag", stage: str | None = None
     if kind in ("shadertoy", "library", "plain"):
         prefix = _library_prefix(text) or ""
         source = render_template("glsl/harness.glsl.j2", kind=kind, body=text, prefix=prefix,
-                                 version=PLAIN_GLSL_VERSION)
+                                 version=PLAIN_GLSL_VERSION,
+                                 double=re.search(r"\bdvec3\b", text) is not None)
         prelude = source[: source.index(text)].count("\n")
     with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
         path = os.path.join(tmp, f"shader.{stage}")

@@ -94,6 +94,7 @@ def test_show_measures_how_far_float32_moves_the_surface():
     assert proc.returncode == 0, proc.stderr
     assert float(re.search(share, proc.stdout).group(1)) > 25, proc.stdout
     assert "warning: float32 cannot hold this surface" in proc.stdout
+    assert "in double it holds: --precision double" in proc.stdout
     proc = implc("show", "-e", "x^18 + y^18 + z^18 = 1")
     assert proc.returncode == 0, proc.stderr
     assert float(re.search(share, proc.stdout).group(1)) == 0.0, proc.stdout

@@ -124,10 +124,18 @@ class ShaderPrinterMixin:
             return self.float_literal(0.0)
         spelled = self.known_functions.get(name)
         if not spelled:
+            refused = self.refusal(row.name)
+            if refused:
+                raise InputError(refused)
             raise ImplcError(f"function '{row.name}' has no {self.target} spelling")
         if row.printed == "fold":
             return self._fold(spelled, expr.args)
         return f"{spelled}({', '.join(self._print(a) for a in expr.args)})"
+
+    def refusal(self, function: str) -> str | None:
+        """Why this printer refuses `function` (a table name), or None: a precision may
+        lack a built-in the language has in another (GLSL's double has no sin)."""
+        return None
 
     def _fold(self, fname: str, args) -> str:
         """min/max of several arguments as a balanced tree of two-argument calls: depth

@@ -38,6 +38,16 @@ def context():
         raise ToolError(f"cannot create a headless OpenGL context (EGL): {err}") from err
 
 
+def double_context():
+    """The context of `context`, which must have GL_ARB_gpu_shader_fp64 (backend
+    gl-double), or ToolError saying it has not."""
+    ctx = context()
+    if "GL_ARB_gpu_shader_fp64" not in ctx.extensions:
+        raise ToolError(f"the OpenGL driver ({ctx.info.get('GL_RENDERER', 'unknown')}) has no "
+                        "GL_ARB_gpu_shader_fp64: no double precision in GLSL (use -b gl)")
+    return ctx
+
+
 def renderer_name() -> str:
     return str(context().info.get("GL_RENDERER", "unknown"))
 
@@ -112,10 +122,17 @@ class GlRunner(TimedRunner):
 
 
 def open_gl_runner(surface: Surface, method: str, constants: Constants, width: int,
-                   height: int, params: str = "constant") -> GlRunner:
-    """Runner factory of backend `gl`: the 330 core program over a full-screen triangle
-    (params="uniform": the parameters are uniforms, moved by `set_params`)."""
-    fragment = emit(surface, "glsl", method, constants, flavor="330", params=params)
+                   height: int, params: str = "constant", precision: str = "float") -> GlRunner:
+    """Runner factory of backend `gl` and, with precision="double", `gl-double`: the 330
+    core program over a full-screen triangle (params="uniform": the parameters are
+    uniforms, moved by `set_params`)."""
+    fragment = emit(surface, "glsl", method, constants, flavor="330", params=params,
+                    precision=precision)
     vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
     uniforms = param_uniforms(surface, "glsl") if params == "uniform" else ()
     return GlRunner(fragment, vertex, surface.view, width, height, uniforms)
+
+
+def open_gl_double_runner(surface: Surface, method: str, constants: Constants, width: int,
+                          height: int, params: str = "constant") -> GlRunner:
+    return open_gl_runner(surface, method, constants, width, height, params, "double")
