@@ -14,6 +14,13 @@ degree 20 and on the gallery rows of issue 21 (corpus rows 137, 163, 244, 247, 2
 
 The points are the sign changes of S on the grid that frames the surface
 (implc/extent.py), so this is a sampling, as the framing is.
+
+The exact method's ray polynomial rounds worse than S (its coefficients about the chord's
+middle sum larger terms), and from degree 7 its Newton reads F from them: `ray_conditioning`
+measures that on the view's pixel rays, with the shader's own coefficient program run in
+float32 against float64. Its share of rays moved beyond T_TOL follows exact's share of
+wrong pixels at 512^2 (Chmutov's T_14: 0.28 % both, T_16 3.5 % against 3.2 %), and where
+it is too large, double precision is the remedy (README, "Drop-in contract (GLSL)").
 """
 
 from __future__ import annotations
@@ -24,15 +31,27 @@ import numpy as np
 import sympy
 
 from .extent import locate_surface, sign_changes
-from .numeric import evaluate
+from .numeric import evaluate, evaluate_program
+from .optimize import Program
 from .options import T_TOL
-from .symbols import POINT
+from .scene import View, clip_sphere, pixel_rays
+from .symbols import DIRECTION, POINT
 
 FLOAT32_UNIT = 2.0**-24  # the unit roundoff of float32
 # From this share of the sampled points moved beyond T_TOL, `implc show` warns: measured
 # at 512^2, Chmutov's T_16 (1.3 %) has 8,313 bad pixels of 262,144 with exact, T_14 (0 %)
 # 735, and Taubin's heart (0.5 %, at its tangent cone) 10.
 WARN_SHARE = 0.01
+# The ray polynomial's rounding is measured on the view's pixel rays, RAYS a side, its first
+# root found among SAMPLES points of the chord and refined by bisection. From RAY_WARN_SHARE
+# of the rays with a root moved beyond T_TOL, `implc show` warns. Measured (the sweep's
+# default view) against exact's bad pixels at 512^2 (docs/RESULTS.md section 8): Chmutov's
+# T_12 0.089 % of the rays (exact: 0.074 % of the pixels bad), T_14 0.28 % (0.28 %), T_16
+# 3.5 % (3.2 %), T_18 20 % (16 %), T_11 and T_10 0 (24 and 8 pixels); corpus rows 163, 244,
+# 285, Barth's decic and sums of powers to degree 20: 0; row 247 0.05 % (7 pixels).
+RAYS = 128
+SAMPLES = 256
+RAY_WARN_SHARE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -87,3 +106,65 @@ def float32_conditioning(expr: sympy.Expr,
     moved = np.broadcast_to(moved, (len(points),))
     return Conditioning(len(points), float(np.median(moved)),
                         float(np.percentile(moved, 90)), float(np.mean(moved > T_TOL)))
+
+
+def ray_conditioning(coefficients: Program, view: View, rays: int = RAYS) -> Conditioning | None:
+    """How far float32's rounding of the ray polynomial's coefficients moves the first
+    root, on `view`'s pixel rays (None: no ray has a root). The coefficients c_0..c_n about
+    the chord's middle are computed by `coefficients` (raypoly.coefficient_program, the
+    shader's own program) from the same float32 ray once in float32 and once in float64;
+    the float64 polynomial's first root u (a sign change) moves by |dF(u)| / |F'(u)|.
+    Where the exact method's Newton reads F from these coefficients, its roots land there."""
+    origins, dirs = pixel_rays(view, rays, rays)
+    origins, dirs = origins.reshape(-1, 3), dirs.reshape(-1, 3)
+    t0, t1, inside = clip_sphere(origins, dirs, view.clip_center, view.clip_radius)
+    # the shader's ray, in float32: it marches from the clip entry, about the chord's middle
+    d = dirs[inside].astype(np.float32)
+    entry = (origins[inside] + t0[inside, None] * dirs[inside]).astype(np.float32)
+    half = (0.5 * (t1[inside] - t0[inside])).astype(np.float32)
+    middle = (entry + half[:, None] * d).astype(np.float32)
+    env32 = {**dict(zip(POINT, middle.T, strict=True)), **dict(zip(DIRECTION, d.T, strict=True))}
+    env64 = {k: v.astype(np.float64) for k, v in env32.items()}
+    shape = (len(half),)
+    exact = np.array([np.broadcast_to(c, shape) for c in evaluate_program(
+        coefficients.assignments, coefficients.outputs, env64)])
+    rounded = np.array([np.broadcast_to(c, shape) for c in evaluate_program(
+        coefficients.assignments, coefficients.outputs, env32, real=np.float32)],
+        dtype=np.float64)
+    root, found = _first_roots(exact, half.astype(np.float64))
+    if not found.any():
+        return None
+    u, c, dc = root[found], exact[:, found], (rounded - exact)[:, found]
+    slope = np.abs(_horner(np.arange(1, len(c))[:, None] * c[1:], u))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        moved = np.where(slope > 0, np.abs(_horner(dc, u)) / slope, np.inf)
+    return Conditioning(len(u), float(np.median(moved)), float(np.percentile(moved, 90)),
+                        float(np.mean(moved > T_TOL)))
+
+
+def _horner(c: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """sum c_k u^k for every ray (c: (n + 1, rays), u: rays or (samples, rays))."""
+    value = np.zeros_like(u) + c[-1]
+    for ck in c[-2::-1]:
+        value = value * u + ck
+    return value
+
+
+def _first_roots(c: np.ndarray, half: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The first sign change of sum c_k u^k on [-half, half] per ray, among SAMPLES points
+    then bisected to float64's resolution, and whether there is one."""
+    grid = np.linspace(-1.0, 1.0, SAMPLES)[:, None] * half
+    with np.errstate(over="ignore", invalid="ignore"):
+        values = _horner(c, grid)
+    change = np.signbit(values[:-1]) != np.signbit(values[1:])
+    found = change.any(axis=0)
+    first = np.argmax(change, axis=0)
+    columns = np.arange(c.shape[1])
+    lo, hi = grid[first, columns], grid[first + 1, columns]
+    f_lo = values[first, columns]
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        f_mid = _horner(c, mid)
+        left = np.signbit(f_mid) != np.signbit(f_lo)
+        hi, lo, f_lo = np.where(left, mid, hi), np.where(left, lo, mid), np.where(left, f_lo, f_mid)
+    return 0.5 * (lo + hi), found

@@ -8,7 +8,7 @@ from .derive import Derivatives, current_max_derived, polynomial_degree
 from .emit import build_functions, function_quantities
 from .marcher import choose_form, evaluations, step_ops
 from .methods import Constants, Method
-from .options import AUTO_RAY_POLY_MAX_DEGREE, T_TOL
+from .options import AUTO_RAY_POLY_MAX_DEGREE, EXACT_MAX_DEGREE, T_TOL
 from .pieces import build_programs
 from .raypoly import (
     HORNER_ABOVE,
@@ -36,7 +36,7 @@ def describe(surface: Surface, method: Method) -> str:
         lines.append("params:    " + ", ".join(f"{k} = {value_text(v)}"
                                                for k, v in surface.params.items()))
     if degree is not None:
-        lines += _float32_lines(surface.expr, d.gradient)
+        lines += _float32_lines(surface, degree, d.gradient)
     lines += [
         "",
         "derived (point form: p = (x, y, z), unit ray direction D = (dx, dy, dz)):",
@@ -66,11 +66,19 @@ def describe(surface: Surface, method: Method) -> str:
     return "\n".join(lines)
 
 
-def _float32_lines(expr: sympy.Expr, gradient: tuple[sympy.Expr, ...]) -> list[str]:
-    """How far float32 rounding of S moves the surface (implc/conditioning.py)."""
-    from .conditioning import WARN_SHARE, float32_conditioning
+def _float32_lines(surface: Surface, degree: int,
+                   gradient: tuple[sympy.Expr, ...]) -> list[str]:
+    """How far float32 rounding moves the surface: S's at sampled points, and (where the
+    exact method's Newton reads F from the ray's coefficients) theirs on the view's pixel
+    rays (implc/conditioning.py); a warning, and the remedy, where either is too far."""
+    from .conditioning import (
+        RAY_WARN_SHARE,
+        WARN_SHARE,
+        float32_conditioning,
+        ray_conditioning,
+    )
 
-    c = float32_conditioning(expr, gradient)
+    c = float32_conditioning(surface.expr, gradient)
     if c is None:
         return ["float32:   not measured (S is not a polynomial in x, y, z as written, or it "
                 "changes sign nowhere framing samples)"]
@@ -78,10 +86,21 @@ def _float32_lines(expr: sympy.Expr, gradient: tuple[sympy.Expr, ...]) -> list[s
              f"{c.p90:.1e} (p90) at {c.points:,} sampled points; {100 * c.far:.1f} % move "
              f"more than {T_TOL:g}, the distance the counts call a wrong root"]
     if c.far >= WARN_SHARE:
-        lines += ["           warning: float32 cannot hold this surface: expect wrong "
-                  "pixels from every method (exact's ray polynomial rounds worse still)",
-                  "           in double it holds: --precision double (-t glsl, flavour 330 "
-                  "or 450, or -t opencl; render -b gl-double or cl-double)"]
+        lines.append("           warning: float32 cannot hold this surface: expect wrong "
+                     "pixels from every method (exact's ray polynomial rounds worse still)")
+    ray = (ray_conditioning(coefficient_program(surface.expr), surface.view)
+           if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
+    if ray is not None:
+        lines.append(f"           exact's ray coefficients (its Newton reads F from them from "
+                     f"degree {ROBUST_NEWTON_BELOW}), rounded as its shader rounds them, move "
+                     f"the first root by {ray.median:.1e} (median), {ray.p90:.1e} (p90) on "
+                     f"{ray.points:,} pixel rays; {100 * ray.far:.2f} % more than {T_TOL:g}")
+        if ray.far >= RAY_WARN_SHARE:
+            lines.append("           warning: expect about that share of exact's pixels "
+                         "with a wrong root in float32")
+    if c.far >= WARN_SHARE or (ray is not None and ray.far >= RAY_WARN_SHARE):
+        lines.append("           in double it holds: --precision double (-t glsl, flavour "
+                     "330 or 450, or -t opencl; render -b gl-double or cl-double)")
     return lines
 
 
