@@ -396,11 +396,12 @@ def _slow_compile_cpu() -> float:
     return cpu
 
 
-@pytest.mark.parametrize("share", [0.55, 0.85])
+@pytest.mark.parametrize("share", [0.5, 0.7])
 def test_sigint_mid_compile_leaves_nothing(tmp_path, share):
     """SIGINT after `share` of the compile's measured CPU time: past the imports (a
     quarter of it or less), inside derive/CSE. CPU time, not wall time, so a loaded
-    machine does not shift it."""
+    machine does not shift it. Not later: at 0.85 one run in many landed in the
+    interpreter's shutdown, where SIGINT's default action kills the process (-2)."""
     cpu = share * _slow_compile_cpu()
     out = tmp_path / "slow.frag"
     proc = subprocess.Popen(

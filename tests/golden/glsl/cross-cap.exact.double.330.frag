@@ -20,7 +20,7 @@ layout(location = 0) out vec4 frag_color;  // shaded colour, a = 1
 layout(location = 1) out vec4 frag_aux;    // (hit 0/1, t from the eye, march steps, |S| at hit)
 
 // Method constants (implc compile options).
-const double TOUCH = 1e-13lf;
+const double TOUCH = 1.862645149230957e-22lf;
 const double ROUND_ERR = 1.7763568394002505e-15lf;
 const double XTOL = 1e-06lf;
 const double CTOL = 0.0003lf;

@@ -20,7 +20,7 @@
 // ndc = (2(i + 0.5)/width - 1, 1 - 2(j + 0.5)/height) (see README).
 
 // Method constants (implc compile options).
-__constant double TOUCH = 1e-13;
+__constant double TOUCH = 1.862645149230957e-22;
 __constant double ROUND_ERR = 1.7763568394002505e-15;
 __constant double XTOL = 1e-06;
 __constant double CTOL = 0.0003;
