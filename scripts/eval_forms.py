@@ -6,6 +6,8 @@ docs/cost-growth.png).
     python scripts/eval_forms.py accuracy --size 512 cross-cap miter ...   markdown table
     python scripts/eval_forms.py sweep --size 512 --plot docs/cost-growth.png
     python scripts/eval_forms.py gallery --size 512 barth-decic 163 285 ...  rows too
+    python scripts/eval_forms.py precision --degrees 12-20 --families chmutov
+        exact in float (gl) and in double (gl-double) against taylor, with counts
 
 Each surface's programs (one per form and method) are timed in turns in one GL context
 (llvmpipe here), one warm-up frame then --frames frames, medians. The sweep's compile
@@ -156,6 +158,41 @@ def sweep(degrees: list[int], size: int, frames: int, plot: str | None,
         _plot(rows, size, plot)
 
 
+def precision(degrees: list[int], size: int, frames: int,
+              families: list[str] | None = None) -> None:
+    """exact in float (`gl`) and in double (`gl-double`) against taylor (`--eval auto`),
+    timed in the same rounds, with their counts against the reference (docs/RESULTS.md,
+    "Double precision in GLSL")."""
+    print("| family | degree | exact float ms | exact double ms | taylor ms | double / float "
+          "| exact float / taylor | exact double / taylor | exact float false / missed / "
+          "wrong | exact double | taylor |")
+    print("|---|---|" + "---|" * 9)
+    exact = get_method("exact").defaults
+    for degree in degrees:
+        for family, equation in sweep_equations(degree).items():
+            if families and family not in families:
+                continue
+            surface = load_surface(equation=equation)
+            taylor = get_method("taylor").constants(
+                evaluation=choose_form(get_method("taylor"), surface.expr))
+            reference = open_runner(surface, "reference", "", taylor, size, size).frame()
+            runners = [open_runner(surface, backend, method, constants, size, size)
+                       for backend, method, constants in (("gl", "exact", exact),
+                                                          ("gl-double", "exact", exact),
+                                                          ("gl", "taylor", taylor))]
+            try:
+                seconds, last, _ = time_interleaved(runners, frames)
+            finally:
+                for r in runners:
+                    r.release()
+            ms = [1000 * statistics.median(s) for s in seconds]
+            counts = [f"{m['false_hits']} / {m['missed_hits']} / {m['wrong_root']}"
+                      for m in (compare(result, reference) for result in last)]
+            print(f"| {family} | {degree} | " + " | ".join(f"{m:.1f}" for m in ms)
+                  + f" | {ms[1] / ms[0]:.2f} | {ms[0] / ms[2]:.2f} | {ms[1] / ms[2]:.2f} | "
+                  + " | ".join(counts) + " |", flush=True)
+
+
 def rows_from_table(path: str) -> list:
     """The sweep's rows back from its printed table (to redraw the plot unmeasured)."""
     rows = []
@@ -233,7 +270,7 @@ def _plot(rows, size: int, path: str) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("mode", choices=("accuracy", "sweep", "gallery"))
+    ap.add_argument("mode", choices=("accuracy", "sweep", "gallery", "precision"))
     ap.add_argument("surfaces", nargs="*")
     ap.add_argument("--size", type=int, default=512)
     ap.add_argument("--frames", type=int, default=3)
@@ -241,7 +278,7 @@ def main() -> None:
     ap.add_argument("--degrees", default="2-20")
     ap.add_argument("--plot")
     ap.add_argument("--families", nargs="+", choices=("powers", "chmutov"),
-                    help="sweep: these families only (default both)")
+                    help="sweep, precision: these families only (default both)")
     ap.add_argument("--from-table", help="sweep: redraw --plot from this printed table "
                     "instead of measuring")
     args = ap.parse_intermixed_args()
@@ -249,6 +286,9 @@ def main() -> None:
         accuracy(args.surfaces, args.methods, args.size, args.frames)
     elif args.mode == "gallery":
         gallery(args.surfaces, args.size, args.frames)
+    elif args.mode == "precision":
+        lo, hi = (int(v) for v in args.degrees.split("-"))
+        precision(list(range(lo, hi + 1)), args.size, args.frames, args.families)
     else:
         if args.from_table:
             _plot(rows_from_table(args.from_table), args.size, args.plot)
