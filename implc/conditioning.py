@@ -33,11 +33,11 @@ import sympy
 from .extent import locate_surface, sign_changes
 from .numeric import evaluate, evaluate_program
 from .optimize import Program
-from .options import T_TOL
+from .options import T_TOL, UNIT_ROUNDOFF
 from .scene import View, clip_sphere, pixel_rays
 from .symbols import DIRECTION, POINT
 
-FLOAT32_UNIT = 2.0**-24  # the unit roundoff of float32
+FLOAT32_UNIT = UNIT_ROUNDOFF["float"]
 # From this share of the sampled points moved beyond T_TOL, `implc show` warns: measured
 # at 512^2, Chmutov's T_16 (1.3 %) has 8,313 bad pixels of 262,144 with exact, T_14 (0 %)
 # 735, and Taubin's heart (0.5 %, at its tangent cone) 10.

@@ -153,7 +153,7 @@ def emit(
     # the camera, the shading and the entry points: in the precision, or float (see
     # Target.float_shading)
     shade_precision = "float" if precision in tgt.float_shading else precision
-    shade_printer = tgt.make_printer(shade_precision)
+    shade_printer = printer if shade_precision == precision else tgt.make_printer("float")
     context = {
         "surface": {"name": surface.name, "equation": equation},
         "params": [{"name": u.name, "uniform": u.uniform, "offset": u.offset,

@@ -91,3 +91,7 @@ TAYLOR2_CHOICES = ("paper", "consistent", "extremum")
 # different root is typically >= 1e-2 away at the step sizes b = 0.002..0.01. 1e-3 sits
 # between the two by an order of magnitude on each side.
 T_TOL = 1e-3
+
+# The unit roundoff of each precision a shader prints in (the solver's rounding bounds and
+# touch tolerance, the float32 conditioning `implc show` measures)
+UNIT_ROUNDOFF = {"float": 2.0**-24, "double": 2.0**-53}

@@ -14,7 +14,7 @@ from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
 from .optimize import count_ops
-from .options import EXACT_MAX_DEGREE
+from .options import EXACT_MAX_DEGREE, UNIT_ROUNDOFF
 from .pieces import (
     Marcher,
     PrintedBody,
@@ -105,7 +105,7 @@ class Solver:
 
 def _unit_roundoff(printer) -> float:
     """The unit roundoff of the precision `printer` prints in."""
-    return 2.0**-53 if getattr(printer, "precision", "float") == "double" else 2.0**-24
+    return UNIT_ROUNDOFF[getattr(printer, "precision", "float")]
 
 
 def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
@@ -127,7 +127,7 @@ def _touch(constants: Constants, printer) -> float:
     near a curve where S vanishes to high order as touches, 65 false hits and 25 wrong
     roots at 512^2 against the certified reference; scaled, 0 / 0 / 0 (the gallery's
     counts unchanged)."""
-    return constants.touch * _unit_roundoff(printer) / 2.0**-24
+    return constants.touch * _unit_roundoff(printer) / UNIT_ROUNDOFF["float"]
 
 
 def _value_function(name: str, n: int, printer, prefix: str,
