@@ -53,7 +53,15 @@ from .options import (
     Constants,
 )
 from .render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
-from .targets import TARGETS, Target, flavor_problem, prefix_problem, target_of_file
+from .targets import (
+    TARGETS,
+    Target,
+    backends_in,
+    flavor_problem,
+    prefix_problem,
+    target_of_file,
+    where_precision,
+)
 
 EPILOG = """\
 surfaces: a TOML file, a SURFER .jsurf file, a bundled example name (see `implc list`),
@@ -551,7 +559,9 @@ def _shader_args(p: argparse.ArgumentParser) -> None:
     precisions = dict.fromkeys(x for t in TARGETS.values() for x in t.precisions)
     p.add_argument("--precision", choices=list(precisions), help="; ".join(
         f"{t.name}: {' or '.join(t.precisions)} (default {t.precisions[0]})"
-        for t in TARGETS.values() if len(t.precisions) > 1))
+        for t in TARGETS.values() if len(t.precisions) > 1) + ". At the default, a "
+        "warning says where float32 cannot hold a polynomial surface (`implc show` "
+        "measures it); --precision float silences it")
     p.add_argument("--params", choices=("constant", "uniform"), default="constant",
                    help="constant (default): parameter values baked into the shader; "
                         "uniform: parameters are uniforms the host sets at run time")
@@ -861,7 +871,34 @@ def cmd_compile(args) -> int:
         write_atomic(args.output, text)
     else:
         sys.stdout.write(text)
+    if args.precision is None:
+        target = TARGETS[args.target]
+        flavor = args.flavor or target.default_flavor
+        _float32_warning(args, surface, "try --precision double"
+                         if "double" in target.precisions
+                         and flavor_problem(target, flavor, "double") is None
+                         else f"--precision double is in {where_precision('double')}")
     return EXIT_OK
+
+
+def _float32_warning(args, surface, remedy: str) -> None:
+    """Warn where float32, the default precision, cannot hold a polynomial surface for
+    the method (conditioning.Float32Report: `implc show` prints both measures); an
+    explicit --precision float says the user knows."""
+    from .derive import polynomial_degree
+    from .show import float32_report
+    from .solver import ROBUST_NEWTON_BELOW
+
+    degree = polynomial_degree(surface.expr)
+    if degree is None:
+        return
+    # exact's warning from degree 7 is its own coefficients' (the other measure, S's at
+    # sampled points, costs 0.04-0.3 s more and speaks for every method)
+    report = float32_report(surface.expr, surface.view, degree,
+                            point=args.method != "exact" or degree < ROBUST_NEWTON_BELOW)
+    message = report.warning(args.method)
+    if message:
+        _warn(args, f"{message}; {remedy}")
 
 
 def _compile_jsurf(args) -> int:
@@ -984,7 +1021,21 @@ def cmd_render(args) -> int:
           f"{_percent(result.hit)} of pixels hit", file=sys.stderr)
     for line in _render_warnings(surface, result, given_radius=args.radius is not None):
         print(line, file=sys.stderr)
+    if args.precision is None and _backend_precision(backend) == "float":
+        from .render.run import backend_for
+
+        try:
+            remedy = f"try -b {backend_for(backend, 'double')}"
+        except InputError:
+            remedy = f"double precision renders with -b {' or '.join(backends_in('double'))}"
+        _float32_warning(args, surface, remedy)
     return EXIT_OK
+
+
+def _backend_precision(backend: str) -> str | None:
+    """The precision `backend` runs its program in (None: the CPU reference)."""
+    return next((t.backends[backend].precision for t in TARGETS.values()
+                 if backend in t.backends), None)
 
 
 def _percent(hit) -> str:

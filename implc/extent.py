@@ -20,6 +20,7 @@ sign-change search is enough for choosing a camera and says what it did.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 import sympy
@@ -40,7 +41,13 @@ SPHERE_SAMPLES = 8192  # points on the clip sphere for `crosses_sphere`
 def locate_surface(expr: sympy.Expr, center: Vec3 | None = None) -> Extent | None:
     """The clip sphere that holds S = 0 (centre `center` when given, else the middle of
     the sign changes), or None when no sign change is found in |p - centre| <= SEARCHED
-    (the cube). Deterministic: the same surface gives the same numbers."""
+    (the cube). Deterministic: the same surface gives the same numbers, kept for the
+    command's next question (framing, then float32's conditioning, ask the same)."""
+    return _locate(expr, None if center is None else tuple(float(c) for c in center))
+
+
+@lru_cache(maxsize=8)
+def _locate(expr: sympy.Expr, center: tuple[float, ...] | None) -> Extent | None:
     origin = np.zeros(3) if center is None else np.asarray(center, dtype=np.float64)
     first_found = None
     for half in GROWING:

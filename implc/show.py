@@ -2,8 +2,17 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import sympy
 
+from .conditioning import (
+    RAY_WARN_SHARE,
+    WARN_SHARE,
+    Conditioning,
+    float32_conditioning,
+    ray_conditioning,
+)
 from .derive import Derivatives, current_max_derived, polynomial_degree
 from .emit import build_functions, function_quantities
 from .marcher import choose_form, evaluations, step_ops
@@ -17,9 +26,58 @@ from .raypoly import (
     estrin_derivative_ops,
     ray_quantity_ops,
 )
+from .scene import View
 from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, walk_cost
 from .surface import Surface
+from .symbols import POINT
+from .targets import where_precision
 from .textform import to_text, value_text
+
+
+@dataclass(frozen=True)
+class Float32Report:
+    """Both measures of a polynomial surface, each None where it does not apply."""
+
+    point: Conditioning | None  # S at sampled points of the surface: every method
+    ray: Conditioning | None  # exact's ray coefficients on the view's pixel rays
+
+    @property
+    def point_warns(self) -> bool:
+        return self.point is not None and self.point.far >= WARN_SHARE
+
+    @property
+    def ray_warns(self) -> bool:
+        return self.ray is not None and self.ray.far >= RAY_WARN_SHARE
+
+    def warning(self, method: str) -> str | None:
+        """What float32 does to `method`'s picture where a measure says it is too far
+        (None where none does): for exact its own coefficients' share, which follows its
+        share of wrong pixels, else S's. `implc show`, `compile` and `render` say it."""
+        if method == "exact" and self.ray_warns:
+            return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
+                    f"moves the first root by more than {T_TOL:g} on "
+                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (expect about "
+                    "that share of wrong pixels)")
+        if self.point_warns:
+            return (f"float32 cannot hold this surface: a rounding of S moves it by more "
+                    f"than {T_TOL:g} at {100 * self.point.far:.1f} % of its sampled points "
+                    "(expect wrong pixels from every method)")
+        return None
+
+
+def float32_report(expr: sympy.Expr, view: View, degree: int,
+                   gradient: tuple[sympy.Expr, ...] | None = None,
+                   point: bool = True) -> Float32Report:
+    """The ray coefficients' measure where exact's Newton reads F from them (degree
+    ROBUST_NEWTON_BELOW to EXACT_MAX_DEGREE), and S's at any degree unless `point` is
+    False (0.04-0.3 s: what a warning for exact alone does not need)."""
+    ray = (ray_conditioning(coefficient_program(expr), view)
+           if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
+    if not point:
+        return Float32Report(None, ray)
+    if gradient is None:
+        gradient = tuple(sympy.diff(expr, v) for v in POINT)
+    return Float32Report(float32_conditioning(expr, gradient), ray)
 
 
 def describe(surface: Surface, method: Method) -> str:
@@ -71,36 +129,28 @@ def _float32_lines(surface: Surface, degree: int,
     """How far float32 rounding moves the surface: S's at sampled points, and (where the
     exact method's Newton reads F from the ray's coefficients) theirs on the view's pixel
     rays (implc/conditioning.py); a warning, and the remedy, where either is too far."""
-    from .conditioning import (
-        RAY_WARN_SHARE,
-        WARN_SHARE,
-        float32_conditioning,
-        ray_conditioning,
-    )
-
-    c = float32_conditioning(surface.expr, gradient)
+    report = float32_report(surface.expr, surface.view, degree, gradient)
+    c, ray = report.point, report.ray
     if c is None:
         return ["float32:   not measured (S is not a polynomial in x, y, z as written, or it "
                 "changes sign nowhere framing samples)"]
     lines = [f"float32:   a rounding of S moves the surface by {c.median:.1e} (median), "
              f"{c.p90:.1e} (p90) at {c.points:,} sampled points; {100 * c.far:.1f} % move "
              f"more than {T_TOL:g}, the distance the counts call a wrong root"]
-    if c.far >= WARN_SHARE:
+    if report.point_warns:
         lines.append("           warning: float32 cannot hold this surface: expect wrong "
                      "pixels from every method (exact's ray polynomial rounds worse still)")
-    ray = (ray_conditioning(coefficient_program(surface.expr), surface.view)
-           if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
     if ray is not None:
         lines.append(f"           exact's ray coefficients (its Newton reads F from them from "
                      f"degree {ROBUST_NEWTON_BELOW}), rounded as its shader rounds them, move "
                      f"the first root by {ray.median:.1e} (median), {ray.p90:.1e} (p90) on "
                      f"{ray.points:,} pixel rays; {100 * ray.far:.2f} % more than {T_TOL:g}")
-        if ray.far >= RAY_WARN_SHARE:
+        if report.ray_warns:
             lines.append("           warning: expect about that share of exact's pixels "
                          "with a wrong root in float32")
-    if c.far >= WARN_SHARE or (ray is not None and ray.far >= RAY_WARN_SHARE):
-        lines.append("           in double it holds: --precision double (-t glsl, flavour "
-                     "330 or 450, or -t opencl; render -b gl-double or cl-double)")
+    if report.point_warns or report.ray_warns:
+        lines.append("           in double it holds: --precision double with "
+                     + where_precision("double"))
     return lines
 
 

@@ -237,6 +237,26 @@ def flavor_problem(target: Target, flavor: str, precision: str = "float") -> str
     return f"unknown {target.name} flavour '{flavor}'; choose from {', '.join(target.flavors)}"
 
 
+def where_precision(precision: str) -> str:
+    """Which targets (and flavours) print in `precision` and which backends render in it,
+    for a remedy: `-t glsl (flavour 330 or 450) or -t opencl; render -b gl-double or
+    cl-double`."""
+    shaders = []
+    for target in TARGETS.values():
+        if precision in target.precisions:
+            able = [f for f in target.flavors if flavor_problem(target, f, precision) is None]
+            shaders.append(f"-t {target.name}"
+                           + (f" (flavour {' or '.join(able)})" if len(target.flavors) > 1
+                              else ""))
+    return f"{' or '.join(shaders)}; render -b {' or '.join(backends_in(precision))}"
+
+
+def backends_in(precision: str) -> list[str]:
+    """The render backends that run their program in `precision`."""
+    return [name for target in TARGETS.values() for name, backend in target.backends.items()
+            if backend.precision == precision]
+
+
 _PREFIX_RE = re.compile(r"[A-Za-z0-9_]*\Z")
 
 

@@ -84,13 +84,8 @@ def test_show_measures_how_far_float32_moves_the_surface():
     (implc/conditioning.py): on Chmutov's T_18 + T_18 + T_18 (coefficients up to 2^17
     against values of order 1) half the sampled points move more than the counts'
     wrong-root distance, and it warns; on x^18 + y^18 + z^18 = 1 none does."""
-    import sympy
-
-    x = sympy.Symbol("x")
-    t18 = sympy.Poly(sympy.chebyshevt(18, x), x)
-    chmutov = " + ".join(f"({c})*{v}^{k}" for (k,), c in t18.terms() for v in "xyz")
     share = r"([\d.]+) % move more than 0.001"
-    proc = implc("show", "-e", chmutov + " = 0")
+    proc = implc("show", "-e", chmutov(18))
     assert proc.returncode == 0, proc.stderr
     assert float(re.search(share, proc.stdout).group(1)) > 25, proc.stdout
     assert "warning: float32 cannot hold this surface" in proc.stdout
@@ -106,6 +101,55 @@ def test_show_measures_how_far_float32_moves_the_surface():
 RAY_SHARE = r"on [\d,]+ pixel rays; ([\d.]+) % more than 0.001"
 
 
+def chmutov(n: int) -> str:
+    """T_n(x) + T_n(y) + T_n(z) = 0 written out, as the degree sweep writes it."""
+    import sympy
+
+    x = sympy.Symbol("x")
+    t = sympy.Poly(sympy.chebyshevt(n, x), x)
+    return " + ".join(f"({c})*{v}^{k}" for (k,), c in t.terms() for v in "xyz") + " = 0"
+
+
+FLOAT32_WARNING = "warning: float32 cannot hold this surface: "
+
+
+def test_compile_and_render_warn_where_float32_cannot_hold_the_surface(tmp_path):
+    """`implc compile` and `render` at the default precision say what `implc show`
+    measures where float32 cannot hold a polynomial surface for the method, and the
+    remedy the target or backend has; the shader is written all the same (exit 0). On
+    Chmutov's T_16 (exact: 3.2 % of its pixels wrong at 512^2) it warns; with an explicit
+    --precision, or on Barth's decic, it says nothing."""
+    from conftest import require_gl
+
+    equation = chmutov(16)
+    out = tmp_path / "c.frag"
+    proc = implc("compile", "-e", equation, "-o", str(out))
+    assert proc.returncode == 0 and out.exists(), proc.stderr
+    assert ("implc compile: " + FLOAT32_WARNING + "rounding exact's ray coefficients moves "
+            "the first root by more than 0.001 on ") in proc.stderr, proc.stderr
+    assert proc.stderr.count("warning") == 1 and "; try --precision double" in proc.stderr
+    # taylor marches on S at points: S's own measure, which speaks for every method
+    proc = implc("compile", "-e", equation, "-m", "taylor", "-o", str(out))
+    assert FLOAT32_WARNING + "a rounding of S moves it by more than 0.001" in proc.stderr
+    # a target without double names those that have it
+    proc = implc("compile", "-e", equation, "-t", "wgsl", "-o", str(tmp_path / "c.wgsl"))
+    assert proc.returncode == 0, proc.stderr
+    assert ("--precision double is in -t glsl (flavour 330 or 450) or -t opencl; render -b "
+            "gl-double or cl-double") in proc.stderr, proc.stderr
+    for precision in ("float", "double"):
+        proc = implc("compile", "-e", equation, "--precision", precision, "-o", str(out))
+        assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
+    proc = implc("compile", "barth-decic", "-o", str(out))
+    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
+    require_gl()
+    png = tmp_path / "c.png"
+    proc = implc("render", "-e", equation, "--size", "32", "-o", str(png))
+    assert proc.returncode == 0 and png.exists(), proc.stderr
+    assert "implc render: " + FLOAT32_WARNING in proc.stderr and "; try -b gl-double" in proc.stderr
+    proc = implc("render", "-e", equation, "--size", "32", "-b", "gl-double", "-o", str(png))
+    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
+
+
 def test_show_measures_how_far_float32_moves_exacts_roots():
     """Where exact's Newton reads F from the ray's coefficients (degree 7 on), `implc show`
     measures how far their float32 rounding moves the first root on the view's pixel rays
@@ -114,12 +158,7 @@ def test_show_measures_how_far_float32_moves_exacts_roots():
     that far (exact in float32 has 0.28 % of its pixels wrong at 512^2), and it warns and
     names double; on Barth's decic none does (exact: 0 / 3 / 4 of 262,144). Fails when the
     float32 program is evaluated in float64."""
-    import sympy
-
-    x = sympy.Symbol("x")
-    t14 = sympy.Poly(sympy.chebyshevt(14, x), x)
-    chmutov = " + ".join(f"({c})*{v}^{k}" for (k,), c in t14.terms() for v in "xyz")
-    proc = implc("show", "-e", chmutov + " = 0")
+    proc = implc("show", "-e", chmutov(14))
     assert proc.returncode == 0, proc.stderr
     assert "0.0 % move more than 0.001" in proc.stdout
     assert 0.1 < float(re.search(RAY_SHARE, proc.stdout).group(1)) < 1, proc.stdout

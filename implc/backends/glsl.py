@@ -17,8 +17,7 @@ from sympy.printing.precedence import PRECEDENCE
 from ..errors import InputError
 from .printing import ShaderPrinterMixin
 
-PRECISIONS = ("float", "double")
-LITERAL_SUFFIX = {"float": "", "double": "lf"}
+LITERAL_SUFFIX = {"float": "", "double": "lf"}  # precision -> its literals' suffix
 
 # sympy class name -> GLSL function, for every row of implc/functions.py that prints as a
 # call (the others: the table's `printed` column). GLSL's two-argument arctangent is an
@@ -42,11 +41,8 @@ class GlslPrinter(ShaderPrinterMixin, GLSLPrinter):
     _kf = known_functions
 
     def __init__(self, precision: str = "float"):
-        if precision not in PRECISIONS:
-            raise ValueError(f"GLSL precision must be one of {', '.join(PRECISIONS)}")
         super().__init__({"use_operators": True})
-        self.precision = precision
-        self.float_suffix = LITERAL_SUFFIX[precision]
+        self.use_precision(precision, LITERAL_SUFFIX)
         if precision == "double":
             self.known_functions = {k: v for k, v in known_functions.items()
                                     if k in DOUBLE_FUNCTIONS}

@@ -16,8 +16,8 @@ from sympy.printing.c import C99CodePrinter
 
 from .printing import ShaderPrinterMixin
 
-PRECISIONS = ("float", "double")
-LITERAL_SUFFIX = {"float": "f", "double": ""}
+LITERAL_SUFFIX = {"float": "f", "double": ""}  # precision -> its literals' suffix
+PRECISIONS = tuple(LITERAL_SUFFIX)
 
 # sympy class name -> OpenCL C built-in, for every row of implc/functions.py that prints as
 # a call (the others: the table's `printed` column). The float forms of abs/min/max are
@@ -35,11 +35,8 @@ class OpenclPrinter(ShaderPrinterMixin, C99CodePrinter):
     _kf = known_functions
 
     def __init__(self, precision: str = "float"):
-        if precision not in PRECISIONS:
-            raise ValueError(f"OpenCL precision must be one of {', '.join(PRECISIONS)}")
         super().__init__({"strict": True})
-        self.precision = precision
-        self.float_suffix = LITERAL_SUFFIX[precision]
+        self.use_precision(precision, LITERAL_SUFFIX)
 
     def print_step(self, arg: str) -> str:
         """Heaviside(x) = 1 for x >= 0, else 0, as a select: the value at 0 is explicit in

@@ -36,6 +36,15 @@ class ShaderPrinterMixin:
         # fabs/abs, GLSL's extras); implc's table decides what prints, so replace, not merge.
         self.known_functions = dict(self._kf)
 
+    def use_precision(self, precision: str, literal_suffix: dict[str, str]) -> None:
+        """Print in `precision`, one of the language's (`literal_suffix`: precision -> the
+        suffix of its literals)."""
+        if precision not in literal_suffix:
+            raise ValueError(f"{self.target} precision must be one of "
+                             f"{', '.join(literal_suffix)}")
+        self.precision = precision
+        self.float_suffix = literal_suffix[precision]
+
     def float_literal(self, value: float) -> str:
         """Shortest decimal that round-trips the float64 value, typed for the target."""
         value = float(value)
