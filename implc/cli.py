@@ -883,7 +883,7 @@ def cmd_compile(args) -> int:
 
 def _float32_warning(args, surface, remedy: str) -> None:
     """Warn where float32, the default precision, cannot hold a polynomial surface for
-    the method (conditioning.Float32Report: `implc show` prints both measures); an
+    the method (show.Float32Report: `implc show` prints both measures); an
     explicit --precision float says the user knows."""
     from .derive import polynomial_degree
     from .show import float32_report
