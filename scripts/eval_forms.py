@@ -7,7 +7,8 @@ docs/cost-growth.png).
     python scripts/eval_forms.py sweep --size 512 --plot docs/cost-growth.png
     python scripts/eval_forms.py gallery --size 512 barth-decic 163 285 ...  rows too
     python scripts/eval_forms.py precision --degrees 12-20 --families chmutov
-        exact in float (gl) and in double (gl-double) against taylor, with counts
+        exact and taylor, each in float (gl) and in double (gl-double), with counts
+        (--no-counts: frames only)
 
 Each surface's programs (one per form and method) are timed in turns in one GL context
 (llvmpipe here), one warm-up frame then --frames frames, medians. The sweep's compile
@@ -158,39 +159,46 @@ def sweep(degrees: list[int], size: int, frames: int, plot: str | None,
         _plot(rows, size, plot)
 
 
+PRECISION_RUNS = (("gl", "exact"), ("gl-double", "exact"), ("gl", "taylor"),
+                  ("gl-double", "taylor"))
+
+
 def precision(degrees: list[int], size: int, frames: int,
-              families: list[str] | None = None) -> None:
-    """exact in float (`gl`) and in double (`gl-double`) against taylor (`--eval auto`),
-    timed in the same rounds, with their counts against the reference (docs/RESULTS.md,
-    "Double precision in GLSL")."""
-    print("| family | degree | exact float ms | exact double ms | taylor ms | double / float "
-          "| exact float / taylor | exact double / taylor | exact float false / missed / "
-          "wrong | exact double | taylor |")
-    print("|---|---|" + "---|" * 9)
-    exact = get_method("exact").defaults
+              families: list[str] | None = None, counts: bool = True) -> None:
+    """exact and taylor (`--eval auto`), each in float (`gl`) and in double (`gl-double`),
+    timed in the same rounds, with their counts against the reference unless `counts` is
+    False (docs/RESULTS.md, "Double precision in GLSL" and "Both methods in double")."""
+    names = [f"{method} {'double' if backend.endswith('double') else 'float'}"
+             for backend, method in PRECISION_RUNS]
+    print("| family | degree | " + " | ".join(f"{n} ms" for n in names)
+          + " | exact float / taylor float | exact double / taylor float | exact double / "
+          "taylor double |" + ("".join(f" {n} false / missed / wrong |" for n in names)
+                               if counts else ""))
+    print("|---|---|" + "---|" * (7 + 4 * counts))
     for degree in degrees:
         for family, equation in sweep_equations(degree).items():
             if families and family not in families:
                 continue
             surface = load_surface(equation=equation)
-            taylor = get_method("taylor").constants(
-                evaluation=choose_form(get_method("taylor"), surface.expr))
-            reference = open_runner(surface, "reference", "", taylor, size, size).frame()
-            runners = [open_runner(surface, backend, method, constants, size, size)
-                       for backend, method, constants in (("gl", "exact", exact),
-                                                          ("gl-double", "exact", exact),
-                                                          ("gl", "taylor", taylor))]
+            constants = {"exact": get_method("exact").defaults,
+                         "taylor": get_method("taylor").constants(
+                             evaluation=choose_form(get_method("taylor"), surface.expr))}
+            reference = (open_runner(surface, "reference", "", constants["taylor"], size,
+                                     size).frame() if counts else None)
+            runners = [open_runner(surface, backend, method, constants[method], size, size)
+                       for backend, method in PRECISION_RUNS]
             try:
                 seconds, last, _ = time_interleaved(runners, frames)
             finally:
                 for r in runners:
                     r.release()
             ms = [1000 * statistics.median(s) for s in seconds]
-            counts = [f"{m['false_hits']} / {m['missed_hits']} / {m['wrong_root']}"
-                      for m in (compare(result, reference) for result in last)]
-            print(f"| {family} | {degree} | " + " | ".join(f"{m:.1f}" for m in ms)
-                  + f" | {ms[1] / ms[0]:.2f} | {ms[0] / ms[2]:.2f} | {ms[1] / ms[2]:.2f} | "
-                  + " | ".join(counts) + " |", flush=True)
+            cells = [f"{m:.1f}" for m in ms] + [f"{ms[0] / ms[2]:.2f}", f"{ms[1] / ms[2]:.2f}",
+                                                f"{ms[1] / ms[3]:.2f}"]
+            if counts:
+                cells += [f"{m['false_hits']} / {m['missed_hits']} / {m['wrong_root']}"
+                          for m in (compare(result, reference) for result in last)]
+            print(f"| {family} | {degree} | " + " | ".join(cells) + " |", flush=True)
 
 
 def rows_from_table(path: str) -> list:
@@ -279,6 +287,8 @@ def main() -> None:
     ap.add_argument("--plot")
     ap.add_argument("--families", nargs="+", choices=("powers", "chmutov"),
                     help="sweep, precision: these families only (default both)")
+    ap.add_argument("--no-counts", action="store_true",
+                    help="precision: frames only, no reference (an hour a row at degree 20)")
     ap.add_argument("--from-table", help="sweep: redraw --plot from this printed table "
                     "instead of measuring")
     args = ap.parse_intermixed_args()
@@ -288,7 +298,8 @@ def main() -> None:
         gallery(args.surfaces, args.size, args.frames)
     elif args.mode == "precision":
         lo, hi = (int(v) for v in args.degrees.split("-"))
-        precision(list(range(lo, hi + 1)), args.size, args.frames, args.families)
+        precision(list(range(lo, hi + 1)), args.size, args.frames, args.families,
+                  counts=not args.no_counts)
     else:
         if args.from_table:
             _plot(rows_from_table(args.from_table), args.size, args.plot)
