@@ -1092,6 +1092,8 @@ def cmd_view(args) -> int:
     write_atomic(args.output, page)
     print(f"wrote {args.output}")
     print(f"open file://{args.output.resolve()} in a browser", file=sys.stderr)
+    _float32_warning(args, surface, "WebGL2 and WebGPU have no double; for the picture, "
+                     f"`implc render -b {' or '.join(backends_in('double'))}`")
     return EXIT_OK
 
 

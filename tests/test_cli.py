@@ -141,6 +141,12 @@ def test_compile_and_render_warn_where_float32_cannot_hold_the_surface(tmp_path)
         assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
     proc = implc("compile", "barth-decic", "-o", str(out))
     assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
+    # the live viewer runs in WebGL2 or WebGPU, which have no double
+    page = tmp_path / "c.html"
+    proc = implc("view", "-e", equation, "-o", str(page))
+    assert proc.returncode == 0 and page.exists(), proc.stderr
+    assert ("implc view: " + FLOAT32_WARNING in proc.stderr
+            and "WebGL2 and WebGPU have no double" in proc.stderr), proc.stderr
     require_gl()
     png = tmp_path / "c.png"
     proc = implc("render", "-e", equation, "--size", "32", "-o", str(png))
