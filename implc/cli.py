@@ -867,24 +867,29 @@ def cmd_compile(args) -> int:
         if not verdict.ok:
             raise ValidationError(verdict.render(name))
         print(verdict.render(name), file=sys.stderr)
+    warning = None
+    if args.precision is None:
+        target = TARGETS[args.target]
+        flavor = args.flavor or target.default_flavor
+        warning = _float32_warning(args, surface, "try --precision double"
+                                   if "double" in target.precisions
+                                   and flavor_problem(target, flavor, "double") is None
+                                   else "--precision double is in "
+                                   + where_precision("double"))
     if args.output:
         write_atomic(args.output, text)
     else:
         sys.stdout.write(text)
-    if args.precision is None:
-        target = TARGETS[args.target]
-        flavor = args.flavor or target.default_flavor
-        _float32_warning(args, surface, "try --precision double"
-                         if "double" in target.precisions
-                         and flavor_problem(target, flavor, "double") is None
-                         else f"--precision double is in {where_precision('double')}")
+    if warning:
+        _warn(args, warning)
     return EXIT_OK
 
 
-def _float32_warning(args, surface, remedy: str) -> None:
-    """Warn where float32, the default precision, cannot hold a polynomial surface for
-    the method (show.Float32Report: `implc show` prints both measures); an
-    explicit --precision float says the user knows."""
+def _float32_warning(args, surface, remedy: str) -> str | None:
+    """The warning where float32, the default precision, cannot hold a polynomial surface
+    for the method (show.Float32Report: `implc show` prints both measures), to print once
+    the command has succeeded; it is measured before any output is written, so an
+    interrupt there leaves none. An explicit --precision float says the user knows."""
     from .derive import polynomial_degree
     from .show import float32_report
     from .solver import ROBUST_NEWTON_BELOW
@@ -897,8 +902,7 @@ def _float32_warning(args, surface, remedy: str) -> None:
     report = float32_report(surface.expr, surface.view, degree,
                             point=args.method != "exact" or degree < ROBUST_NEWTON_BELOW)
     message = report.warning(args.method)
-    if message:
-        _warn(args, f"{message}; {remedy}")
+    return f"{message}; {remedy}" if message else None
 
 
 def _compile_jsurf(args) -> int:
@@ -1006,6 +1010,15 @@ def cmd_render(args) -> int:
     _resolve_method(args, surface)
     _warn_ignored(args, backend)
     _check_frame(surface, width, height)
+    warning = None
+    if args.precision is None and _backend_precision(backend) == "float":
+        from .render.run import backend_for
+
+        try:
+            remedy = f"try -b {backend_for(backend, 'double')}"
+        except InputError:
+            remedy = f"double precision renders with -b {' or '.join(backends_in('double'))}"
+        warning = _float32_warning(args, surface, remedy)
     start = time.perf_counter()
     paths, result = render_surface(surface, backend, args.method, _constants(args), width,
                                    height, args.output, params=args.params)
@@ -1021,14 +1034,8 @@ def cmd_render(args) -> int:
           f"{_percent(result.hit)} of pixels hit", file=sys.stderr)
     for line in _render_warnings(surface, result, given_radius=args.radius is not None):
         print(line, file=sys.stderr)
-    if args.precision is None and _backend_precision(backend) == "float":
-        from .render.run import backend_for
-
-        try:
-            remedy = f"try -b {backend_for(backend, 'double')}"
-        except InputError:
-            remedy = f"double precision renders with -b {' or '.join(backends_in('double'))}"
-        _float32_warning(args, surface, remedy)
+    if warning:
+        _warn(args, warning)
     return EXIT_OK
 
 
@@ -1089,11 +1096,14 @@ def cmd_view(args) -> int:
     _resolve_method(args, surface)
     _warn_ignored(args)
     page = viewer_page(surface, args.method, _constants(args), webgpu=not args.no_webgpu)
+    warning = _float32_warning(args, surface, "WebGL2 and WebGPU have no double; for the "
+                               "picture, `implc render -b "
+                               + " or ".join(backends_in("double")) + "`")
     write_atomic(args.output, page)
     print(f"wrote {args.output}")
     print(f"open file://{args.output.resolve()} in a browser", file=sys.stderr)
-    _float32_warning(args, surface, "WebGL2 and WebGPU have no double; for the picture, "
-                     f"`implc render -b {' or '.join(backends_in('double'))}`")
+    if warning:
+        _warn(args, warning)
     return EXIT_OK
 
 
