@@ -896,7 +896,7 @@ def _float32_warning(args, surface, remedy: str) -> str | None:
 
     degree = polynomial_degree(surface.expr)
     if degree is None:
-        return
+        return None
     # exact's warning from degree 7 is its own coefficients' (the other measure, S's at
     # sampled points, costs 0.04-0.3 s more and speaks for every method)
     report = float32_report(surface.expr, surface.view, degree,
