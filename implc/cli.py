@@ -1011,7 +1011,7 @@ def cmd_render(args) -> int:
     _warn_ignored(args, backend)
     _check_frame(surface, width, height)
     warning = None
-    if args.precision is None and _backend_precision(backend) == "float":
+    if args.precision is None and backend != REFERENCE and BACKENDS[backend].precision == "float":
         from .render.run import backend_for
 
         try:
@@ -1037,12 +1037,6 @@ def cmd_render(args) -> int:
     if warning:
         _warn(args, warning)
     return EXIT_OK
-
-
-def _backend_precision(backend: str) -> str | None:
-    """The precision `backend` runs its program in (None: the CPU reference)."""
-    return next((t.backends[backend].precision for t in TARGETS.values()
-                 if backend in t.backends), None)
 
 
 def _percent(hit) -> str:

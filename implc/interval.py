@@ -281,7 +281,7 @@ def range_function(name: str, program: RangeProgram, printer, prefix: str,
 def range_constants(printer, prefix: str) -> tuple[tuple[str, str, str], ...]:
     """The interval march's named constants (type, name, printed value)."""
     K = prefix.upper()  # noqa: N806 (the constants' prefix, as the templates name it)
-    ulp, tiny = WIDENING[getattr(printer, "precision", "float")]
+    ulp, tiny = WIDENING[printer.precision]
     return (("real", K + "IV_ULP", printer.float_literal(ulp)),
             ("real", K + "IV_TINY", printer.float_literal(tiny)),
             ("real", K + "START_WIDTH", printer.float_literal(2.0**-START)),

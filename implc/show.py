@@ -52,7 +52,8 @@ class Float32Report:
     def warning(self, method: str) -> str | None:
         """What float32 does to `method`'s picture where a measure says it is too far
         (None where none does): for exact its own coefficients' share, which follows its
-        share of wrong pixels, else S's. `implc show`, `compile` and `render` say it."""
+        share of wrong pixels, else S's: the line `compile`, `render` and `view` print
+        (`implc show` prints both measures in full)."""
         if method == "exact" and self.ray_warns:
             return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
                     f"moves the first root by more than {T_TOL:g} on "

@@ -105,7 +105,7 @@ class Solver:
 
 def _unit_roundoff(printer) -> float:
     """The unit roundoff of the precision `printer` prints in."""
-    return UNIT_ROUNDOFF[getattr(printer, "precision", "float")]
+    return UNIT_ROUNDOFF[printer.precision]
 
 
 def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:

@@ -27,6 +27,7 @@ FLOAT32_MAX = 3.4028234663852886e38
 
 class ShaderPrinterMixin:
     target: str = ""
+    precision: str = "float"  # a printer with several sets it (use_precision)
     float_suffix: str = ""
     _kf: dict[str, str] = {}  # the printer module's `known_functions`
 
@@ -50,7 +51,7 @@ class ShaderPrinterMixin:
         value = float(value)
         if value != value or value in (float("inf"), float("-inf")):
             raise ImplcError(f"the {self.target} printer cannot print the number {value}")
-        if abs(value) > FLOAT32_MAX and getattr(self, "precision", "float") == "float":
+        if abs(value) > FLOAT32_MAX and self.precision == "float":
             # WGSL refuses such a literal, GLSL makes it inf: say so before either
             raise InputError(f"too large for float32: the constant {value:.6g} (in S or "
                              f"its derivatives) is beyond "
