@@ -63,6 +63,15 @@ ROBUST_NEWTON_BELOW = 7
 BERNSTEIN_DEPTH = 14
 BERNSTEIN_MAX_NODES = 96
 
+# A node that must be halved is descended up to this many levels at once: to the deepest
+# node at its left end that still holds its control polygon's first sign change (b_(i-1),
+# b_i with i/n < 2^-L), where F's first root most likely is; skipping a level's left
+# half costs a node either way, and the stackless walk moves up again by itself. Measured
+# at 512^2 (docs/RESULTS.md section 8): nodes a ray on Chmutov's T18 in double 4.46 ->
+# 3.88, frames 0.89-0.95 of one level at a time on T12-T20, x^18 sums unchanged; up to 2
+# levels about the same, 4 worse.
+DESCENT_LEVELS = 3
+
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
@@ -101,6 +110,9 @@ class Solver:
     control_step: str = ""
     # bernstein: the Newton after the walk takes F's robust value (ROBUST_NEWTON_BELOW)
     robust_newton: bool = False
+    # bernstein: a descent's levels (see DESCENT_LEVELS), shallowest first: (L, 2^-L
+    # printed, the pairs (b_(i-1), b_i) by i whose sign change sends it L levels down)
+    descent: tuple[tuple[int, str, tuple[int, ...]], ...] = ()
 
 
 def _unit_roundoff(printer) -> float:
@@ -209,7 +221,9 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         control_w = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
         robust_newton = n < ROBUST_NEWTON_BELOW
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
-                        control_w, printer.float_literal(2 / n), robust_newton)
+                        control_w, printer.float_literal(2 / n), robust_newton,
+                        tuple((level, printer.float_literal(0.5 ** level), pairs)
+                              for level, pairs in descent_levels(n)))
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
@@ -220,6 +234,13 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
                    empty, solver, carried)
+
+
+def descent_levels(n: int) -> tuple[tuple[int, tuple[int, ...]], ...]:
+    """For L = 2..DESCENT_LEVELS, the pairs (b_(i-1), b_i) with i/n < 2^-L: a sign change
+    there sends a descent L levels down (the deepest such L wins)."""
+    return tuple((level, pairs) for level in range(2, DESCENT_LEVELS + 1)
+                 if (pairs := tuple(i for i in range(1, n + 1) if i * 2 ** level < n)))
 
 
 def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], ...]:
