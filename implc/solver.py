@@ -72,6 +72,19 @@ BERNSTEIN_MAX_NODES = 96
 # levels about the same, 4 worse.
 DESCENT_LEVELS = 3
 
+# After a skipped node the walk's next node is the widest its position allows, unless
+# F heads towards zero at the skipped node's end: then it is narrowed to the largest
+# power of two within NEXT_REACH times the distance where the control polygon's last leg
+# (b_(n-1), b_n) meets zero, by at most NEXT_HALVINGS halvings and not below 1/NEXT_FLOOR
+# of the skipped node. A wide next node there would hold that zero with others and be
+# halved again. Simulated (scripts/walk_sim.py, 64^2): the SIMD block's most nodes on
+# Chmutov's T18 7.06 -> 5.86, T12 5.86 -> 5.08, T20 7.36 -> 6.13, x^18 sums 1.91 -> 1.71;
+# factors 2, 3, 5 and 8 gave 8.10, 6.38, 5.92 and 6.61 on T18. Measured at 512^2
+# (docs/RESULTS.md section 8): frames 0.90-0.97 of the widest next node.
+NEXT_REACH = 4
+NEXT_HALVINGS = 4
+NEXT_FLOOR = 4
+
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
@@ -113,6 +126,11 @@ class Solver:
     # bernstein: a descent's levels (see DESCENT_LEVELS), shallowest first: (L, 2^-L
     # printed, the pairs (b_(i-1), b_i) by i whose sign change sends it L levels down)
     descent: tuple[tuple[int, str, tuple[int, ...]], ...] = ()
+    # bernstein: NEXT_REACH/n printed (the next node's reach is it times |b_n/(b_n -
+    # b_(n-1))| times the skipped node's width), 1/NEXT_FLOOR printed, NEXT_HALVINGS
+    next_reach: str = ""
+    next_floor: str = ""
+    next_halvings: int = 0
 
 
 def _unit_roundoff(printer) -> float:
@@ -223,7 +241,9 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
                         control_w, printer.float_literal(2 / n), robust_newton,
                         tuple((level, printer.float_literal(0.5 ** level), pairs)
-                              for level, pairs in descent_levels(n)))
+                              for level, pairs in descent_levels(n)),
+                        printer.float_literal(NEXT_REACH / n),
+                        printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS)
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
