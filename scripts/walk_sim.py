@@ -1,9 +1,10 @@
 """The exact method's Bernstein walk (templates/solver.j2) re-run in float64 on a view's
-pixel rays, to weigh descent rules before building them: nodes a ray (mean) and the mean
-over 4x4 pixel blocks of the most any pixel of the block took (what a SIMD group pays),
-for one level a descent, the shipped rule (solver.DESCENT_LEVELS) and the lower bound:
-the fewest nodes any descent rule could visit, the dyadic cover of the chord up to the
-first root by nodes that Descartes' rule proves root-free, and the root's node
+pixel rays, to weigh its rules for the next node before building them: nodes a ray
+(mean) and the mean over 4x4 pixel blocks of the most any pixel of the block took (what a
+SIMD group pays), for the plain walk (one level a descent, the widest next node after a
+skip), the shipped rules added one by one (solver.DESCENT_LEVELS, NEXT_HALVINGS) and the
+lower bound: the fewest nodes any rule could visit, the dyadic cover of the chord up to
+the first root by nodes that Descartes' rule proves root-free, and the root's node
 (docs/RESULTS.md section 8).
 
     python scripts/walk_sim.py "x^18 + y^18 + z^18 - 1 = 0" --size 64
@@ -20,7 +21,15 @@ from scipy.special import comb
 from implc.conditioning import DIRECTION, POINT, clip_sphere, pixel_rays
 from implc.numeric import evaluate_program
 from implc.raypoly import coefficient_program
-from implc.solver import BERNSTEIN_DEPTH, BERNSTEIN_MAX_NODES, DESCENT_LEVELS, descent_levels
+from implc.solver import (
+    BERNSTEIN_DEPTH,
+    BERNSTEIN_MAX_NODES,
+    DESCENT_LEVELS,
+    NEXT_FLOOR,
+    NEXT_HALVINGS,
+    NEXT_REACH,
+    descent_levels,
+)
 from implc.surface import load_surface
 
 MIN_WIDTH = 2.0 ** -BERNSTEIN_DEPTH
@@ -62,12 +71,16 @@ class Ray:
     def value(self, w: float) -> float:
         return float(self.f(2 * w - 1))
 
-    def crossings(self, pos: float, width: float) -> np.ndarray:
-        """Which pairs (b_(i-1), b_i) of the node's coefficients change sign (0 counts)."""
+    def bernstein(self, pos: float, width: float) -> np.ndarray:
+        """The node's Bernstein coefficients b_0..b_n."""
         middle = 2 * (pos + width / 2) - 1
         e = np.array([self.f.deriv(k)(middle) / math.factorial(k) * width ** k
                       for k in range(self.n + 1)])
-        b = self.matrix @ e
+        return self.matrix @ e
+
+    def crossings(self, pos: float, width: float) -> np.ndarray:
+        """Which pairs (b_(i-1), b_i) of the node's coefficients change sign (0 counts)."""
+        b = self.bernstein(pos, width)
         return b[:-1] * b[1:] <= 0
 
     def first_root(self) -> float:
@@ -85,8 +98,9 @@ class Ray:
         return 0.5 * (lo + hi)
 
 
-def walk(ray: Ray, levels: int) -> int:
-    """Nodes the walk visits, a descent going down up to `levels` levels at once."""
+def walk(ray: Ray, levels: int, halvings: int) -> int:
+    """Nodes the walk visits, a descent going down up to `levels` levels at once, the next
+    node after a skip narrowed by up to `halvings` halvings."""
     rule = descent_levels(ray.n) if levels > 1 else ()
     rule = tuple((level, pairs) for level, pairs in rule if level <= levels)
     pos, width, index, nodes = 0.0, 0.5, 0, 0
@@ -94,7 +108,8 @@ def walk(ray: Ray, levels: int) -> int:
     while nodes < BERNSTEIN_MAX_NODES:
         nodes += 1
         right = ray.value(pos + width)
-        cross = ray.crossings(pos, width)
+        b = ray.bernstein(pos, width)
+        cross = b[:-1] * b[1:] <= 0
         changes, change = int(cross.sum()), left * right < 0
         if change and (changes == 1 or width <= MIN_WIDTH):
             return nodes
@@ -105,12 +120,19 @@ def walk(ray: Ray, levels: int) -> int:
                        default=1)
             width, index = width / 2 ** down, index << down
             continue
+        toward = b[-1] * (b[-1] - b[-2]) < 0
+        reach = NEXT_REACH / ray.n * abs(b[-1] / (b[-1] - b[-2])) * width if toward else 0.0
+        least = width / NEXT_FLOOR
         left, pos = right, pos + width
         if pos >= 1.0:
             return nodes
         index += 1
         low = index & -index
         index, width = index // low, width * low
+        if toward:
+            for _ in range(halvings):
+                width = width / 2 if width > reach and width > least else width
+            index = int(pos / width)
     return nodes
 
 
@@ -139,8 +161,10 @@ def main() -> None:
     c, inside = chord_polynomials(args.equation, args.size)
     matrix = bernstein_matrix(len(c) - 1)
     rays = {j: Ray(c[:, j], matrix) for j in np.nonzero(inside)[0]}
-    rules = {"one level a descent": lambda ray: walk(ray, 1),
-             f"up to {DESCENT_LEVELS} levels (shipped)": lambda ray: walk(ray, DESCENT_LEVELS),
+    rules = {"plain": lambda ray: walk(ray, 1, 0),
+             f"descent up to {DESCENT_LEVELS} levels": lambda ray: walk(ray, DESCENT_LEVELS, 0),
+             "and the next node narrowed (shipped)":
+                 lambda ray: walk(ray, DESCENT_LEVELS, NEXT_HALVINGS),
              "lower bound": lambda ray: lower_bound(ray, ray.first_root())}
     blocks = args.size // 4
     for name, count in rules.items():
@@ -148,7 +172,7 @@ def main() -> None:
         for j, ray in rays.items():
             nodes[j] = count(ray)
         block_max = nodes.reshape(blocks, 4, blocks, 4).max(axis=(1, 3)).mean()
-        print(f"{name:28s} nodes a ray {nodes[list(rays)].mean():5.2f}, "
+        print(f"{name:38s} nodes a ray {nodes[list(rays)].mean():5.2f}, "
               f"4x4 block max {block_max:5.2f}", flush=True)
 
 
