@@ -85,6 +85,19 @@ NEXT_REACH = 4
 NEXT_HALVINGS = 4
 NEXT_FLOOR = 4
 
+# The walk's first node, the chord's left half, is narrowed the same way where F heads
+# towards zero at the chord's start: to the largest power of two within FIRST_REACH times
+# F's Newton step there (|F/F'|, F' = grad S . d at the point, once a ray), by at most
+# FIRST_HALVINGS halvings (to 1/16 of the chord). Simulated (scripts/walk_sim.py, 64^2),
+# the SIMD block's most nodes after the rules above: Chmutov's T18 5.86 -> 5.29, T12 5.08
+# -> 4.80, T20 6.14 -> 5.57, x^18 sums 1.71 -> 1.79; factors 4, 16 and 32 gave 5.52, 5.73
+# and 5.82 on T18. Measured at 512^2 (docs/RESULTS.md section 8): frames 0.92-0.96 on
+# Chmutov. (F' from the ray's coefficients by Estrin's scheme instead made x^9 and x^10
+# sums and T5 1.35x slower with the same nodes, pixel for pixel: llvmpipe's code for the
+# walk's loop, not the walk.)
+FIRST_REACH = 8
+FIRST_HALVINGS = 3
+
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
@@ -131,6 +144,9 @@ class Solver:
     next_reach: str = ""
     next_floor: str = ""
     next_halvings: int = 0
+    # bernstein: FIRST_REACH printed, FIRST_HALVINGS
+    first_reach: str = ""
+    first_halvings: int = 0
 
 
 def _unit_roundoff(printer) -> float:
@@ -243,7 +259,8 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         tuple((level, printer.float_literal(0.5 ** level), pairs)
                               for level, pairs in descent_levels(n)),
                         printer.float_literal(NEXT_REACH / n),
-                        printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS)
+                        printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS,
+                        printer.float_literal(FIRST_REACH), FIRST_HALVINGS)
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(

@@ -2,10 +2,10 @@
 pixel rays, to weigh its rules for the next node before building them: nodes a ray
 (mean) and the mean over 4x4 pixel blocks of the most any pixel of the block took (what a
 SIMD group pays), for the plain walk (one level a descent, the widest next node after a
-skip), the shipped rules added one by one (solver.DESCENT_LEVELS, NEXT_HALVINGS) and the
-lower bound: the fewest nodes any rule could visit, the dyadic cover of the chord up to
-the first root by nodes that Descartes' rule proves root-free, and the root's node
-(docs/RESULTS.md section 8).
+skip, the chord's left half first), the shipped rules added one by one
+(solver.DESCENT_LEVELS, NEXT_HALVINGS, FIRST_HALVINGS) and the lower bound: the fewest
+nodes any rule could visit, the dyadic cover of the chord up to the first root by nodes
+that Descartes' rule proves root-free, and the root's node (docs/RESULTS.md section 8).
 
     python scripts/walk_sim.py "x^18 + y^18 + z^18 - 1 = 0" --size 64
 """
@@ -25,6 +25,8 @@ from implc.solver import (
     BERNSTEIN_DEPTH,
     BERNSTEIN_MAX_NODES,
     DESCENT_LEVELS,
+    FIRST_HALVINGS,
+    FIRST_REACH,
     NEXT_FLOOR,
     NEXT_HALVINGS,
     NEXT_REACH,
@@ -98,13 +100,17 @@ class Ray:
         return 0.5 * (lo + hi)
 
 
-def walk(ray: Ray, levels: int, halvings: int) -> int:
+def walk(ray: Ray, levels: int, halvings: int, first: int = 0) -> int:
     """Nodes the walk visits, a descent going down up to `levels` levels at once, the next
-    node after a skip narrowed by up to `halvings` halvings."""
+    node after a skip narrowed by up to `halvings` halvings, the first by up to `first`."""
     rule = descent_levels(ray.n) if levels > 1 else ()
     rule = tuple((level, pairs) for level, pairs in rule if level <= levels)
     pos, width, index, nodes = 0.0, 0.5, 0, 0
     left = ray.value(0.0)
+    slope = 2 * ray.f.deriv()(-1.0)  # F' at the chord's start, in chord units
+    if left * slope < 0:
+        for _ in range(first):
+            width = width / 2 if width > FIRST_REACH * abs(left / slope) else width
     while nodes < BERNSTEIN_MAX_NODES:
         nodes += 1
         right = ray.value(pos + width)
@@ -163,8 +169,9 @@ def main() -> None:
     rays = {j: Ray(c[:, j], matrix) for j in np.nonzero(inside)[0]}
     rules = {"plain": lambda ray: walk(ray, 1, 0),
              f"descent up to {DESCENT_LEVELS} levels": lambda ray: walk(ray, DESCENT_LEVELS, 0),
-             "and the next node narrowed (shipped)":
-                 lambda ray: walk(ray, DESCENT_LEVELS, NEXT_HALVINGS),
+             "and the next node narrowed": lambda ray: walk(ray, DESCENT_LEVELS, NEXT_HALVINGS),
+             "and the first node narrowed (shipped)":
+                 lambda ray: walk(ray, DESCENT_LEVELS, NEXT_HALVINGS, FIRST_HALVINGS),
              "lower bound": lambda ray: lower_bound(ray, ray.first_root())}
     blocks = args.size // 4
     for name, count in rules.items():
