@@ -100,6 +100,14 @@ class Ray:
         return 0.5 * (lo + hi)
 
 
+def narrowed(width: float, reach: float, halvings: int, least: float = 0.0) -> float:
+    """`width` halved while wider than `reach` and `least`, at most `halvings` times (the
+    template's `narrowed`)."""
+    for _ in range(halvings):
+        width = width / 2 if width > reach and width > least else width
+    return width
+
+
 def walk(ray: Ray, levels: int, halvings: int, first: int = 0) -> int:
     """Nodes the walk visits, a descent going down up to `levels` levels at once, the next
     node after a skip narrowed by up to `halvings` halvings, the first by up to `first`."""
@@ -109,8 +117,7 @@ def walk(ray: Ray, levels: int, halvings: int, first: int = 0) -> int:
     left = ray.value(0.0)
     slope = 2 * ray.f.deriv()(-1.0)  # F' at the chord's start, in chord units
     if left * slope < 0:
-        for _ in range(first):
-            width = width / 2 if width > FIRST_REACH * abs(left / slope) else width
+        width = narrowed(width, FIRST_REACH * abs(left / slope), first)
     while nodes < BERNSTEIN_MAX_NODES:
         nodes += 1
         right = ray.value(pos + width)
@@ -136,8 +143,7 @@ def walk(ray: Ray, levels: int, halvings: int, first: int = 0) -> int:
         low = index & -index
         index, width = index // low, width * low
         if toward:
-            for _ in range(halvings):
-                width = width / 2 if width > reach and width > least else width
+            width = narrowed(width, reach, halvings, least)
             index = int(pos / width)
     return nodes
 
