@@ -243,8 +243,14 @@ _EXPANDED = ("x^9 - 3x^7y^2 + 5x^5y^2z^2 - 7x^3y^4z + 2x y^8 - 4y^6z^3 + 6z^9 - 
              " + 4x^3y^3z^3 - 6x^5y^4 + 7y^2z^7 - 5x^7z^2 + 3x^2y^6z - 9x^4y z^4 + 2y^7z^2")
 
 
+# A sum of univariate polynomials with a few mixed terms: x^e, y^e and z^e alone take
+# the Taylor shift (raypoly._shifted), the mixed ones Horner's loop.
+_SUMS = ("7x^11 - 3x^9 + 2x^4 - x + y^10 - 5y^7 + 2y^3 + 7z^12 - 4z^8 + z^2 + 3x y z"
+         " - 2x^2y^3 + z^5x + 1.5")
+
+
 @pytest.mark.parametrize("example", ["cross-cap", "steiner", "clebsch", "barth-decic",
-                                     "expanded"])
+                                     "expanded", "sums"])
 def test_both_routes_to_the_ray_coefficients_agree(example):
     """Horner's nested scheme (raypoly.horner_program) and the tree's truncated
     arithmetic (derive.ray_coefficients) give the same c_0..c_n at random (o, d); an
@@ -253,10 +259,11 @@ def test_both_routes_to_the_ray_coefficients_agree(example):
     from implc.optimize import count_ops
     from implc.raypoly import HORNER_ABOVE, coefficient_program, horner_program
 
-    if example == "expanded":
-        expr = load_surface(equation=_EXPANDED).expr
-        assert count_ops(expr) > HORNER_ABOVE
-        assert coefficient_program(expr) == horner_program(expr)
+    if example in ("expanded", "sums"):
+        expr = load_surface(equation=_EXPANDED if example == "expanded" else _SUMS).expr
+        if example == "expanded":
+            assert count_ops(expr) > HORNER_ABOVE
+            assert coefficient_program(expr) == horner_program(expr)
         p, d = _points("cross-cap")
     else:
         expr = load_surface(example).expr
