@@ -139,10 +139,12 @@ def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
     shift: c_j = d^j p_j(o), p_j = sum_(e >= j) a_e C(e, j) v^(e - j), all p_j(o) by
     repeated synthetic division (Horner's rule again, as stable in float32), one
     multiply-add each, where Horner's loop over (o + d s) pays a product and a multiply-add
-    for every coefficient of every step. Measured on Chmutov's T20 in double at 512^2
-    (docs/RESULTS.md section 8): ray_of 0.87 of Horner's, the frame 0.96. (The p_j as sums
-    of a_e C(e, j) o^(e - j) instead: 0.93, but in float32 T16's wrong roots rose 8,303 ->
-    26,615 of 262,144, where the shift gave 6,902: the sums' terms cancel.)"""
+    for every coefficient of every step. Measured on Chmutov's T_n sums at 512^2
+    (docs/RESULTS.md section 8): ray_of 0.87 of Horner's at T20 in double, frames
+    0.93-0.97 at T18 and T20 in double and T13-T18 in float, wrong roots in float 8,303 ->
+    7,509 at T16. (The p_j as sums of a_e C(e, j) o^(e - j) from o's powers instead, which
+    skip the zero a_e: about as fast, but T16's wrong roots rose to 26,615: the sums' terms
+    cancel where Horner's partial sums stay small.)"""
     top = max(constants)
     p: list = [constants.get(e) for e in range(top + 1)]  # None: zero
     for j in range(top):
