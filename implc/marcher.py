@@ -226,7 +226,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
                  for name, program in programs.items()]
     fields, ray = (), PrintedBody((), ())  # the point form's ray record: o, d and sm only
     if form == "ray-poly":
-        coefficients = coefficient_program(expr)
+        coefficients = coefficient_program(expr, printer.precision)
         n = len(coefficients.outputs) - 1
         fields, ray = ray_setup(coefficients, printer, size=False)
         functions += [estrin_function(q, n, printer) for kind, q in wanted if kind == "ray"]

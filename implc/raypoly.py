@@ -8,6 +8,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Sequence
 from functools import lru_cache
+from math import comb
 
 import sympy
 
@@ -29,15 +30,16 @@ DERIVATIVE_ORDER = {"S": 0, "dS": 1, "d2S": 2}
 
 
 @lru_cache(maxsize=32)
-def coefficient_program(expr: sympy.Expr) -> Program:
-    """The ray polynomial's coefficients c_0..c_n from (o, d). An equation written
-    factored keeps its factors: truncated polynomial arithmetic over S's own tree, jointly
-    CSE'd. One written out at length (more than HORNER_ABOVE operations) takes Horner's
-    scheme nested over x, y, z (horner_program), which needs no CSE."""
+def coefficient_program(expr: sympy.Expr, precision: str) -> Program:
+    """The ray polynomial's coefficients c_0..c_n from (o, d), for a shader computing in
+    `precision`. An equation written factored keeps its factors: truncated polynomial
+    arithmetic over S's own tree, jointly CSE'd. One written out at length (more than
+    HORNER_ABOVE operations) takes Horner's scheme nested over x, y, z (horner_program),
+    which needs no CSE."""
     if polynomial_degree(expr) is None:
         raise InputError("the ray-poly form needs a polynomial surface")
     if coefficient_route(expr) == "horner":
-        return horner_program(expr)
+        return horner_program(expr, precision)
     return optimize(list(ray_coefficients(expr)), POINT + DIRECTION)
 
 
@@ -58,13 +60,14 @@ def coefficient_route(expr: sympy.Expr) -> str:
 HORNER_ABOVE = 150
 
 
-def horner_program(expr: sympy.Expr) -> Program:
+def horner_program(expr: sympy.Expr, precision: str) -> Program:
     """c_0..c_n by Horner's scheme on the expanded polynomial, nested over the variables
     in the order that costs least: S = sum_i x^i (sum_j y^j (sum_k a_ijk z^k)), each sum
     a Horner loop on truncated polynomials in s, where a step multiplies by the ray's
     linear polynomial (x + dx s), about 3 operations a coefficient. Every coefficient of
     every step is named (q0, q1, ...), so the program needs no CSE. The orders are
-    compared by counting alone (building one order's sympy expressions is the cost)."""
+    compared by counting alone (building one order's sympy expressions is the cost).
+    `precision` chooses how powers standing alone are shifted (_shifted)."""
     poly = sympy.Poly(expr, *POINT)
     n = int(poly.total_degree())
     terms = dict(poly.terms())
@@ -77,7 +80,7 @@ def horner_program(expr: sympy.Expr) -> Program:
     costs = []
     for order in itertools.permutations(range(3)):
         ops = 0
-        _horner(terms, order, n, count)
+        _horner(terms, order, n, count, precision)
         costs.append((ops, order))
     order = min(costs)[1]  # the first of equals: deterministic
     assignments: list[tuple[sympy.Symbol, sympy.Expr]] = []
@@ -90,13 +93,13 @@ def horner_program(expr: sympy.Expr) -> Program:
         assignments.append((symbol, value))
         return symbol
 
-    outputs = _horner(terms, order, n, named)
+    outputs = _horner(terms, order, n, named, precision)
     outputs += [sympy.S.Zero] * (n + 1 - len(outputs))
     total = sum(count_ops(v) for _, v in assignments)
     return Program(POINT + DIRECTION, tuple(assignments), tuple(outputs), total, total)
 
 
-def _horner(terms: dict, order: tuple[int, ...], n: int, combine) -> list:
+def _horner(terms: dict, order: tuple[int, ...], n: int, combine, precision: str) -> list:
     """The ray coefficients of sum a_m v^m (m: exponents in POINT order) by Horner's
     scheme nested in `order`; `combine(parts)` makes the value sum value*factor (factor
     None: the value alone) of each coefficient of each step, or counts it."""
@@ -125,7 +128,7 @@ def _horner(terms: dict, order: tuple[int, ...], n: int, combine) -> list:
         if plain:
             constants = {e: terms[_unpermuted(prefix + (e,) + (0,) * (2 - depth), order)]
                          for e in plain}
-            direct = _shifted(constants, o, d, combine)
+            direct = _shifted(constants, o, d, combine, precision)
             q = [combine([(v[m], None) for v in (q, direct) if m < len(v)])
                  for m in range(max(len(q), len(direct)))]
         return q
@@ -134,23 +137,34 @@ def _horner(terms: dict, order: tuple[int, ...], n: int, combine) -> list:
 
 
 def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
-             combine) -> list:
+             combine, precision: str) -> list:
     """The ray coefficients of sum a_e v^e over `constants` (e -> a_e, e >= 1) by a Taylor
-    shift: c_j = d^j p_j(o), p_j = sum_(e >= j) a_e C(e, j) v^(e - j), all p_j(o) by
-    repeated synthetic division (Horner's rule again, as stable in float32), one
-    multiply-add each, where Horner's loop over (o + d s) pays a product and a multiply-add
-    for every coefficient of every step. Measured on Chmutov's T_n sums at 512^2
-    (docs/RESULTS.md section 8): ray_of 0.87 of Horner's at T20 in double, frames
-    0.93-0.97 at T18 and T20 in double and T13-T18 in float, wrong roots in float 8,303 ->
-    7,509 at T16. (The p_j as sums of a_e C(e, j) o^(e - j) from o's powers instead, which
-    skip the zero a_e: about as fast, but T16's wrong roots rose to 26,615: the sums' terms
-    cancel where Horner's partial sums stay small.)"""
+    shift: c_j = d^j p_j(o), p_j = sum_(e >= j) a_e C(e, j) v^(e - j). Horner's loop over
+    (o + d s) pays a product and a multiply-add for every coefficient of every step; here
+    each p_j(o) costs a multiply-add a term:
+    - in float32, all p_j by repeated synthetic division (Horner's rule again), which
+      rounds least;
+    - in double, each p_j by its own Horner's rule, in v^2 where its powers are all even
+      or all odd (Chmutov's T_n, x^n sums): half the steps, and independent chains.
+    Measured on Chmutov's T_n sums at 512^2 (docs/RESULTS.md section 8), against Horner's
+    loop: frames 0.93-0.97 at T13-T18 in float32 with fewer wrong roots (T16 8,303 ->
+    7,509 of 262,144); in double the division 0.93-0.97 at T18 and T20, the parity
+    Horner 0.93 of that, with 0 / 0 / 0 kept. In float32 the parity Horner put T16's
+    wrong roots at 16,719, and sums of a_e C(e, j) o^(e - j) at 26,615: their terms
+    cancel where the division's partial sums stay small."""
     top = max(constants)
-    p: list = [constants.get(e) for e in range(top + 1)]  # None: zero
-    for j in range(top):
-        for e in range(top - 1, j - 1, -1):
-            parts = ([] if p[e] is None else [(p[e], None)]) + [(p[e + 1], o)]
-            p[e] = combine(parts)
+    if precision == "float":
+        p: list = [constants.get(e) for e in range(top + 1)]  # None: zero
+        for j in range(top):
+            for e in range(top - 1, j - 1, -1):
+                p[e] = combine(([] if p[e] is None else [(p[e], None)]) + [(p[e + 1], o)])
+    else:
+        a = {e: combine([(value, None)]) for e, value in sorted(constants.items())}
+        sums = [{e - j: comb(e, j) * value for e, value in a.items() if e >= j}
+                for j in range(top + 1)]
+        square = (combine([(o, o)]) if any(_parity(terms)[0] == 2 for terms in sums)
+                  else None)
+        p = [_horner_at(o, square, terms, combine) for terms in sums]
     direct = [p[0]]  # set by the first pass, as is every p[e] below top
     power = d
     for j in range(1, top + 1):
@@ -158,6 +172,26 @@ def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
             power = combine([(power, d)])
         direct.append(combine([(p[j], power)]))
     return direct
+
+
+def _parity(terms: dict[int, sympy.Expr]) -> tuple[int, int]:
+    """(stride, lowest power) of Horner's rule on sum K_g o^g over `terms`: (2, 0) where
+    every g is even, (2, 1) where every g is odd (steps in o^2), else (1, 0)."""
+    parities = {g % 2 for g in terms}
+    return (2, parities.pop()) if len(parities) == 1 and max(terms) > 1 else (1, 0)
+
+
+def _horner_at(o: sympy.Symbol, square, terms: dict[int, sympy.Expr],
+               combine) -> sympy.Expr:
+    """sum K_g o^g over `terms` (g -> K_g) by Horner's rule, in o^2 = `square` (then
+    times o where every g is odd) as _parity says."""
+    stride, low = _parity(terms)
+    v = square if stride == 2 else o
+    top = max(terms)
+    h = terms[top]
+    for g in range(top - stride, low - 1, -stride):
+        h = combine([(h, v)] + ([(terms[g], None)] if g in terms else []))
+    return combine([(h, o)]) if low else h
 
 
 def _permuted(monomial: tuple[int, ...], order: tuple[int, ...]) -> tuple[int, ...]:

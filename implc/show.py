@@ -72,7 +72,7 @@ def float32_report(expr: sympy.Expr, view: View, degree: int,
     """The ray coefficients' measure where exact's Newton reads F from them (degree
     ROBUST_NEWTON_BELOW to EXACT_MAX_DEGREE), and S's at any degree unless `point` is
     False (0.04-0.3 s: what a warning for exact alone does not need)."""
-    ray = (ray_conditioning(coefficient_program(expr), view)
+    ray = (ray_conditioning(coefficient_program(expr, "float"), view)
            if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
     if not point:
         return Float32Report(None, ray)
@@ -173,7 +173,7 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
     if method.bounds:
         return ["", "ray-poly form: not used (the interval method encloses S's tree over "
                     "segments)"]
-    coefficients = coefficient_program(surface.expr)
+    coefficients = coefficient_program(surface.expr, "float")
     if method.solves:
         return [
             "",

@@ -205,7 +205,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
     functions = [point_function(name, program, printer, carried)
                  for name, program in programs.items()]
-    coefficients = coefficient_program(expr)
+    coefficients = coefficient_program(expr, printer.precision)
     n = len(coefficients.outputs) - 1
     u = sym("u")
     bernstein = n >= BERNSTEIN_FROM

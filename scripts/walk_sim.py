@@ -42,7 +42,7 @@ def chord_polynomials(equation: str, size: int) -> tuple[np.ndarray, np.ndarray]
     outside the clip sphere), and whether the ray meets the clip sphere."""
     surface = load_surface(equation=equation)
     view = surface.view
-    program = coefficient_program(surface.expr)
+    program = coefficient_program(surface.expr, "double")  # float64, as this simulation
     origins, dirs = (a.reshape(-1, 3) for a in pixel_rays(view, size, size))
     t0, t1, inside = clip_sphere(origins, dirs, view.clip_center, view.clip_radius)
     half = 0.5 * (t1 - t0)

@@ -249,10 +249,12 @@ _SUMS = ("7x^11 - 3x^9 + 2x^4 - x + y^10 - 5y^7 + 2y^3 + 7z^12 - 4z^8 + z^2 + 3x
          " - 2x^2y^3 + z^5x + 1.5")
 
 
+@pytest.mark.parametrize("precision", ["float", "double"])
 @pytest.mark.parametrize("example", ["cross-cap", "steiner", "clebsch", "barth-decic",
                                      "expanded", "sums"])
-def test_both_routes_to_the_ray_coefficients_agree(example):
-    """Horner's nested scheme (raypoly.horner_program) and the tree's truncated
+def test_both_routes_to_the_ray_coefficients_agree(example, precision):
+    """Horner's nested scheme (raypoly.horner_program, whose powers standing alone are
+    shifted one way for float32 and another for double) and the tree's truncated
     arithmetic (derive.ray_coefficients) give the same c_0..c_n at random (o, d); an
     equation written out at length takes Horner's route."""
     from implc.derive import ray_coefficients
@@ -263,12 +265,12 @@ def test_both_routes_to_the_ray_coefficients_agree(example):
         expr = load_surface(equation=_EXPANDED if example == "expanded" else _SUMS).expr
         if example == "expanded":
             assert count_ops(expr) > HORNER_ABOVE
-            assert coefficient_program(expr) == horner_program(expr)
+            assert coefficient_program(expr, precision) == horner_program(expr, precision)
         p, d = _points("cross-cap")
     else:
         expr = load_surface(example).expr
         p, d = _points(example)
-    program = horner_program(expr)
+    program = horner_program(expr, precision)
     got = evaluate_program(program.assignments, program.outputs, _env(p, d))
     want = [evaluate(c, _env(p, d)) for c in ray_coefficients(expr)]
     for k, (g, w) in enumerate(zip(got, want, strict=True)):
