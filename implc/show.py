@@ -206,8 +206,9 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
 
 
 ROUTES = {"tree": "by truncated arithmetic over S's tree as written, jointly CSE'd",
-          "horner": f"by Horner's scheme nested over x, y, z (S is written out at length: "
-                    f"over {HORNER_ABOVE} operations)"}
+          "horner": f"by Horner's scheme nested over x, y, z, powers standing alone by a "
+                    f"Taylor shift (S is written out at length: over {HORNER_ABOVE} "
+                    f"operations; counted as printed for float32)"}
 
 
 def _short(expr: sympy.Expr, limit: int = 200) -> str:
