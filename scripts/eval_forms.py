@@ -8,7 +8,7 @@ docs/cost-growth.png).
     python scripts/eval_forms.py gallery --size 512 barth-decic 163 285 ...  rows too
     python scripts/eval_forms.py precision --degrees 12-20 --families chmutov
         exact and taylor, each in float (gl) and in double (gl-double), with counts
-        (--no-counts: frames only)
+        (--no-counts: frames only; --plot docs/precision.png: the ratios drawn)
 
 Each surface's programs (one per form and method) are timed in turns in one GL context
 (llvmpipe here), one warm-up frame then --frames frames, medians. The sweep's compile
@@ -164,10 +164,13 @@ PRECISION_RUNS = (("gl", "exact"), ("gl-double", "exact"), ("gl", "taylor"),
 
 
 def precision(degrees: list[int], size: int, frames: int,
-              families: list[str] | None = None, counts: bool = True) -> None:
+              families: list[str] | None = None, counts: bool = True,
+              plot: str | None = None) -> None:
     """exact and taylor (`--eval auto`), each in float (`gl`) and in double (`gl-double`),
     timed in the same rounds, with their counts against the reference unless `counts` is
-    False (docs/RESULTS.md, "Double precision in GLSL" and "Both methods in double")."""
+    False (docs/RESULTS.md, "Double precision in GLSL" and "Both methods in double");
+    `plot`: exact / taylor in each precision against the degree, drawn there."""
+    rows = []
     names = [f"{method} {'double' if backend.endswith('double') else 'float'}"
              for backend, method in PRECISION_RUNS]
     print("| family | degree | " + " | ".join(f"{n} ms" for n in names)
@@ -199,6 +202,32 @@ def precision(degrees: list[int], size: int, frames: int,
                 cells += [f"{m['false_hits']} / {m['missed_hits']} / {m['wrong_root']}"
                           for m in (compare(result, reference) for result in last)]
             print(f"| {family} | {degree} | " + " | ".join(cells) + " |", flush=True)
+            rows.append((family, degree, ms[0] / ms[2], ms[1] / ms[3]))
+    if plot:
+        _plot_precision(rows, size, plot)
+
+
+def _plot_precision(rows, size: int, path: str) -> None:
+    """exact / taylor against the degree, both methods in float32 and both in double."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.2), dpi=110)
+    for family, style in (("powers", "-"), ("chmutov", "--")):
+        data = [r for r in rows if r[0] == family]
+        for column, color, label in ((2, "tab:green", "float32"), (3, "tab:purple", "double")):
+            ax.plot([r[1] for r in data], [r[column] for r in data], style, marker="o",
+                    color=color, label=f"{family}, both in {label}")
+    ax.axhline(0.67, color="grey", lw=1, ls=":", label="goal 0.67")
+    ax.set_title(f"exact / taylor (b = 0.01) frame time, {size}x{size}, llvmpipe")
+    ax.set_xlabel("degree of S")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+    print(f"wrote {path}")
 
 
 def rows_from_table(path: str) -> list:
@@ -299,7 +328,7 @@ def main() -> None:
     elif args.mode == "precision":
         lo, hi = (int(v) for v in args.degrees.split("-"))
         precision(list(range(lo, hi + 1)), args.size, args.frames, args.families,
-                  counts=not args.no_counts)
+                  counts=not args.no_counts, plot=args.plot)
     else:
         if args.from_table:
             _plot(rows_from_table(args.from_table), args.size, args.plot)
