@@ -166,7 +166,7 @@ def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
         square = (combine([(o, o)]) if any(_parity(terms)[0] == 2 for terms in sums)
                   else None)
         p = [_horner_at(o, square, terms, combine) for terms in sums]
-    direct = [p[0]]  # set by the first pass, as is every p[e] below top
+    direct = [p[0]]  # never None: the division's first pass sets every p[e] below top
     power = d
     for j in range(1, top + 1):
         if j > 1:

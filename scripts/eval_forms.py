@@ -209,12 +209,8 @@ def precision(degrees: list[int], size: int, frames: int,
 
 def _plot_precision(rows, size: int, path: str) -> None:
     """exact / taylor against the degree, both methods in float32 and both in double."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 4.2), dpi=110)
+    fig, axes = _figure(1, (7, 4.2))
+    ax = axes[0]
     for family, style in (("powers", "-"), ("chmutov", "--")):
         data = [r for r in rows if r[0] == family]
         for column, color, label in ((2, "tab:green", "float32"), (3, "tab:purple", "double")):
@@ -222,12 +218,7 @@ def _plot_precision(rows, size: int, path: str) -> None:
                     color=color, label=f"{family}, both in {label}")
     ax.axhline(0.67, color="grey", lw=1, ls=":", label="goal 0.67")
     ax.set_title(f"exact / taylor (b = 0.01) frame time, {size}x{size}, llvmpipe")
-    ax.set_xlabel("degree of S")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path)
-    print(f"wrote {path}")
+    _save(fig, axes, path)
 
 
 def rows_from_table(path: str) -> list:
@@ -267,12 +258,7 @@ def gallery(names: list[str], size: int, frames: int) -> None:
 
 
 def _plot(rows, size: int, path: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2), dpi=110)
+    fig, axes = _figure(3, (15, 4.2))
     colors = dict(zip(SWEEP_RUNS, ("tab:green", "tab:blue", "tab:orange", "tab:red"),
                       strict=True))
     for family, style in (("powers", "-"), ("chmutov", "--")):
@@ -295,6 +281,22 @@ def _plot(rows, size: int, path: str) -> None:
     axes[1].set_title("exact / taylor (b = 0.01) frame time")
     axes[2].set_title("compile (Mesa shader cache off)")
     axes[2].set_ylabel("seconds")
+    _save(fig, axes, path)
+
+
+def _figure(columns: int, size: tuple[float, float]):
+    """A figure of `columns` plots side by side (matplotlib without a display)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, columns, figsize=size, dpi=110, squeeze=False)
+    return fig, list(axes[0])
+
+
+def _save(fig, axes, path: str) -> None:
+    """Every plot against the degree, gridded, with its legend; written to `path`."""
     for ax in axes:
         ax.set_xlabel("degree of S")
         ax.grid(alpha=0.3)
