@@ -5,6 +5,8 @@ docs/cost-growth.png).
 
     python scripts/eval_forms.py accuracy --size 512 cross-cap miter ...   markdown table
     python scripts/eval_forms.py sweep --size 512 --plot docs/cost-growth.png
+        each row solved in float32, or in double where float32 cannot hold S (the
+        compile's warning for every method), exact / taylor in float32 beside
     python scripts/eval_forms.py gallery --size 512 barth-decic 163 285 ...  rows too
     python scripts/eval_forms.py precision --degrees 12-20 --families chmutov
         exact and taylor, each in float (gl) and in double (gl-double), with counts
@@ -24,6 +26,7 @@ import os
 import statistics
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "true")  # compile times are cold
 
@@ -92,24 +95,46 @@ SWEEP_RUNS = (("exact", "auto"), ("taylor", "point"), ("taylor", "ray-poly"),
               ("hessian", "auto"))
 
 
-def measure_sweep(surface, size: int, frames: int) -> dict:
-    """Per (method, form) of SWEEP_RUNS, timed in the same rounds: median ms, the metrics
-    against the reference, implc's emit seconds (in process, sympy included) and the
-    driver's compile seconds (program build plus first draw, llvmpipe compiling there;
-    the Mesa shader cache is off, see main)."""
+def float32_holds(surface) -> bool:
+    """Whether float32 holds S in its view: the compile's warning for every method (a
+    rounding of S moves its surface by more than T_TOL at 1 % of its sampled points,
+    implc/conditioning.py) does not fire. Where it fires no method's float32 picture is
+    right (Chmutov from degree 16: 52 % of the points at 18, 66 % at 20), so the sweep
+    solves both methods in double there, as the warning advises."""
+    from implc.show import float32_report
+
+    degree = polynomial_degree(surface.expr)
+    return degree is None or not float32_report(surface.expr, surface.view, degree,
+                                                ).point_warns
+
+
+def measure_sweep(surface, size: int, frames: int, precision: str = "float") -> dict:
+    """Per (method, form) of SWEEP_RUNS solved in `precision`, timed in the same rounds:
+    median ms, the metrics against the reference, implc's emit seconds (in process, sympy
+    included) and the driver's compile seconds (program build plus first draw, llvmpipe
+    compiling there; the Mesa shader cache is off, see main). In double, exact and taylor
+    (its `auto` form) in float32 too, in the same rounds, keyed (method, form, "float32")."""
     from implc.emit import emit
 
     reference = open_runner(surface, "reference", "", get_method("taylor").defaults,
                             size, size).frame()
+    backend = "gl" if precision == "float" else "gl-double"
+    keys = list(SWEEP_RUNS)
+    if precision != "float":
+        keys += [("exact", "auto", "float32"),
+                 ("taylor", choose_form(get_method("taylor"), surface.expr), "float32")]
     runners, emits, builds = [], [], []
     try:
-        for method, form in SWEEP_RUNS:
+        for key in keys:
+            method, form = key[:2]
             constants = get_method(method).constants(evaluation=form)
             start = time.perf_counter()
-            emit(surface, "glsl", method, constants)
+            emit(surface, "glsl", method, constants,
+                 precision=precision if len(key) == 2 else "float")
             emits.append(time.perf_counter() - start)
             start = time.perf_counter()  # emit again (cached) and build the GL program
-            runners.append(open_runner(surface, "gl", method, constants, size, size))
+            runners.append(open_runner(surface, backend if len(key) == 2 else "gl", method,
+                                       constants, size, size))
             builds.append(time.perf_counter() - start)
         seconds, last, first_use = time_interleaved(runners, frames)
     finally:
@@ -117,44 +142,67 @@ def measure_sweep(surface, size: int, frames: int) -> dict:
             r.release()
     return {key: {"ms": 1000 * statistics.median(s), "emit_s": e, "driver_s": b + f,
                   **compare(result, reference)}
-            for key, s, result, e, b, f in zip(SWEEP_RUNS, seconds, last, emits, builds,
+            for key, s, result, e, b, f in zip(keys, seconds, last, emits, builds,
                                                first_use, strict=True)}
 
 
 _HEADER = ("exact ms | taylor point ms | taylor ray-poly ms | hessian ms | exact / taylor | "
            "exact false / missed / wrong | taylor false / missed / wrong | "
-           "hessian false / missed / wrong | exact emit s | exact driver compile s |")
+           "hessian false / missed / wrong | exact emit s | exact driver compile s | "
+           "solved in | exact / taylor, both in float32 |")
+_MEASURED_COLUMNS = 12
 
 
-def _measured_row(first: str, surface, size: int, frames: int) -> tuple[dict, float]:
-    """Measure `surface` (measure_sweep), print its table row after the cells `first`,
-    and return the measurements and exact / taylor (the form `--eval auto` picks)."""
-    r = measure_sweep(surface, size, frames)
-    taylor = r["taylor", choose_form(get_method("taylor"), surface.expr)]
+class Row(NamedTuple):
+    """One row of the sweep: exact / taylor (the form `--eval auto` picks) as measured in
+    the precision `solved` (float or double), and as measured in float32."""
+
+    family: str
+    degree: int
+    measured: dict
+    ratio: float
+    solved: str
+    in_float32: float
+
+
+def _measured_row(first: str, surface, size: int, frames: int) -> tuple[dict, float, str,
+                                                                        float]:
+    """Measure `surface` (measure_sweep, in double where float32 does not hold it), print
+    its table row after the cells `first`, and return the measurements, exact / taylor,
+    the precision solved in and exact / taylor in float32."""
+    precision = "float" if float32_holds(surface) else "double"
+    r = measure_sweep(surface, size, frames, precision)
+    form = choose_form(get_method("taylor"), surface.expr)
+    taylor = r["taylor", form]
     exact = r["exact", "auto"]
     counts = [f"{c['false_hits']} / {c['missed_hits']} / {c['wrong_root']}"
               for c in (exact, taylor, r["hessian", "auto"])]
+    in_float32 = (exact["ms"] / taylor["ms"] if precision == "float" else
+                  r["exact", "auto", "float32"]["ms"] / r["taylor", form, "float32"]["ms"])
     print(f"| {first} | " + " | ".join(f"{r[k]['ms']:.1f}" for k in SWEEP_RUNS)
           + f" | {exact['ms'] / taylor['ms']:.2f} | " + " | ".join(counts)
-          + f" | {exact['emit_s']:.2f} | {exact['driver_s']:.2f} |", flush=True)
-    return r, exact["ms"] / taylor["ms"]
+          + f" | {exact['emit_s']:.2f} | {exact['driver_s']:.2f} | "
+          + f"{'float32' if precision == 'float' else 'double'} | {in_float32:.2f} |",
+          flush=True)
+    return r, exact["ms"] / taylor["ms"], precision, in_float32
 
 
 def sweep(degrees: list[int], size: int, frames: int, plot: str | None,
           families: list[str] | None = None) -> None:
     """The degree sweep (docs/RESULTS.md): exact against taylor (b = 0.01, both forms;
     `taylor` in the ratio is the form `auto` picks) and hessian, per family and degree
-    (`families`: some of them only)."""
+    (`families`: some of them only); each row solved in float32, or in double where
+    float32 does not hold the surface (float32_holds), exact / taylor in float32 beside."""
     rows = []
     print(f"| family | degree | {_HEADER}")
-    print("|---|---|" + "---|" * 10)
+    print("|---|---|" + "---|" * _MEASURED_COLUMNS)
     for degree in degrees:
         for family, equation in sweep_equations(degree).items():
             if families and family not in families:
                 continue
             surface = load_surface(equation=equation)
-            r, ratio = _measured_row(f"{family} | {degree}", surface, size, frames)
-            rows.append((family, degree, r, ratio))
+            rows.append(Row(family, degree, *_measured_row(f"{family} | {degree}", surface,
+                                                           size, frames)))
     if plot:
         _plot(rows, size, plot)
 
@@ -226,12 +274,16 @@ def rows_from_table(path: str) -> list:
     rows = []
     for line in Path(path).read_text(encoding="utf-8").splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) != 12 or not cells[1].isdigit():
+        if len(cells) not in (12, 14) or not cells[1].isdigit():
             continue
         ms = [_number(c) for c in cells[2:6]]
         r = {key: {"ms": m} for key, m in zip(SWEEP_RUNS, ms, strict=True)}
         r["exact", "auto"].update(emit_s=_number(cells[10]), driver_s=_number(cells[11]))
-        rows.append((cells[0], int(cells[1]), r, _number(cells[6])))
+        # tables before the precision columns were all solved in float32
+        solved, in_float32 = (("double" if cells[12] == "double" else "float",
+                               _number(cells[13])) if len(cells) == 14
+                              else ("float", _number(cells[6])))
+        rows.append(Row(cells[0], int(cells[1]), r, _number(cells[6]), solved, in_float32))
     return rows
 
 
@@ -248,7 +300,7 @@ def gallery(names: list[str], size: int, frames: int) -> None:
     rows = {r.number: r for r in load_rows(default_tsv())} if any(
         n.isdigit() for n in names) else {}
     print(f"| surface | degree | {_HEADER}")
-    print("|---|---|" + "---|" * 10)
+    print("|---|---|" + "---|" * _MEASURED_COLUMNS)
     for name in names:
         if name.isdigit():
             surface, label = row_surface(rows[int(name)]), f"{rows[int(name)].name} ({name})"
@@ -257,25 +309,35 @@ def gallery(names: list[str], size: int, frames: int) -> None:
         _measured_row(f"{label} | {polynomial_degree(surface.expr)}", surface, size, frames)
 
 
-def _plot(rows, size: int, path: str) -> None:
+def _plot(rows: list[Row], size: int, path: str) -> None:
+    """Frame times, exact / taylor and compile times against the degree; rows solved in
+    double drawn hollow, with exact / taylor in float32 beside them (thin, dotted)."""
     fig, axes = _figure(3, (15, 4.2))
     colors = dict(zip(SWEEP_RUNS, ("tab:green", "tab:blue", "tab:orange", "tab:red"),
                       strict=True))
     for family, style in (("powers", "-"), ("chmutov", "--")):
-        data = [r for r in rows if r[0] == family]
-        degrees = [r[1] for r in data]
+        data = [r for r in rows if r.family == family]
+        degrees = [r.degree for r in data]
+        double = [r for r in data if r.solved == "double"]
         for key in SWEEP_RUNS:
             label = key[0] if key[1] == "auto" else f"{key[0]} {key[1]}"
-            axes[0].plot(degrees, [r[2][key]["ms"] for r in data], style, marker="o",
+            axes[0].plot(degrees, [r.measured[key]["ms"] for r in data], style, marker="o",
                          color=colors[key], label=f"{label}, {family}")
-        axes[1].plot(degrees, [r[3] for r in data], style, marker="o", color="tab:green",
+        axes[1].plot(degrees, [r.ratio for r in data], style, marker="o", color="tab:green",
                      label=f"exact / taylor, {family}")
-        axes[2].plot(degrees, [r[2]["exact", "auto"]["driver_s"] for r in data], style,
+        if double:
+            axes[1].plot([r.degree for r in double], [r.ratio for r in double], "o",
+                         mfc="white", color="tab:green",
+                         label=f"{family}: both solved in double (float32 cannot hold S)")
+            axes[1].plot([r.degree for r in double], [r.in_float32 for r in double], ":",
+                         marker=".", color="tab:gray", lw=1,
+                         label=f"{family}: both in float32 anyway (wrong pictures)")
+        axes[2].plot(degrees, [r.measured["exact", "auto"]["driver_s"] for r in data], style,
                      marker="o", color="tab:green", label=f"exact, driver, {family}")
-        axes[2].plot(degrees, [r[2]["exact", "auto"]["emit_s"] for r in data], style,
+        axes[2].plot(degrees, [r.measured["exact", "auto"]["emit_s"] for r in data], style,
                      marker="o", color="tab:purple", label=f"exact, implc emit, {family}")
     axes[1].axhline(0.67, color="grey", lw=1, ls=":", label="goal 0.67")
-    axes[0].set_title(f"frame time, {size}x{size}, llvmpipe")
+    axes[0].set_title(f"frame time, {size}x{size}, llvmpipe (each row as solved)")
     axes[0].set_ylabel("ms per frame (median)")
     axes[0].set_yscale("log")
     axes[1].set_title("exact / taylor (b = 0.01) frame time")
