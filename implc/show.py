@@ -175,12 +175,17 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
                     "segments)"]
     coefficients = coefficient_program(surface.expr, "float")
     if method.solves:
+        # double's program differs only where powers stand alone on Horner's route
+        double = coefficient_program(surface.expr, "double").ops_after
         return [
             "",
             "exact (root isolation of the ray polynomial; no marching):",
             f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
             f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries), "
             + ROUTES[coefficient_route(surface.expr)],
+            *([f"  in double (--precision double): {double} ops (one Horner's rule a "
+               "coefficient, in o^2 where its powers share a parity)"]
+              if double != coefficients.ops_after else []),
             *_solver_lines(surface.expr, degree, coefficients.ops_after),
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"

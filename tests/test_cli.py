@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from cases import chmutov
 from conftest import require_tool
 
 from implc.targets import TARGETS
@@ -77,6 +78,19 @@ def test_show_estimates_the_bernstein_walk_per_ray():
     # a node: the shift's 342 operations, 35 scalings, 36 for the sign changes, the
     # Bernstein sums, and S at the point (21 operations, printed above) plus the point
     assert node > 342 + 35 + 36 + 21 + 6
+    assert "in double" not in proc.stdout  # the tree's route: one program for both
+
+
+def test_show_counts_the_ray_coefficients_in_each_precision():
+    """On Horner's route with powers standing alone (Chmutov's T16 written out) the
+    coefficient program differs by precision (raypoly._shifted), and show counts both:
+    float32's (the estimate's) and double's, which is shorter."""
+    proc = implc("show", "-e", chmutov(16))
+    assert proc.returncode == 0, proc.stderr
+    single = re.search(r"coefficients c0..c16, once per ray: \d+ -> (\d+) ops", proc.stdout)
+    double = re.search(r"in double \(--precision double\): (\d+) ops", proc.stdout)
+    assert single and double, proc.stdout
+    assert int(double.group(1)) < int(single.group(1))
 
 
 def test_show_measures_how_far_float32_moves_the_surface():
@@ -99,15 +113,6 @@ def test_show_measures_how_far_float32_moves_the_surface():
 
 
 RAY_SHARE = r"on [\d,]+ pixel rays; ([\d.]+) % more than 0.001"
-
-
-def chmutov(n: int) -> str:
-    """T_n(x) + T_n(y) + T_n(z) = 0 written out, as the degree sweep writes it."""
-    import sympy
-
-    x = sympy.Symbol("x")
-    t = sympy.Poly(sympy.chebyshevt(n, x), x)
-    return " + ".join(f"({c})*{v}^{k}" for (k,), c in t.terms() for v in "xyz") + " = 0"
 
 
 FLOAT32_WARNING = "warning: float32 cannot hold this surface: "

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cases import EXAMPLES, PAPER
+from cases import EXAMPLES, PAPER, chmutov
 from conftest import require_backend, require_gl, require_tool
 from gl_rays import intersect
 
@@ -202,7 +202,7 @@ def test_bernstein_walk_chooses_its_nodes(monkeypatch, setting, plain):
     from implc.scene import View
 
     require_backend("gl-double")
-    surface = load_surface(equation=_chmutov(18))
+    surface = load_surface(equation=chmutov(18))
     surface = type(surface)("chmutov-18", surface.expr, view=View(clip_radius=1.2))
     size = 64
     chosen = render(surface, "gl-double", "exact", METHODS["exact"].defaults, size, size)
@@ -276,16 +276,6 @@ def _assert_exact_at_128(surface, backend: str, fill: float) -> None:
     assert m["missed_hits"] + m["wrong_root"] <= 0.001 * size * size, m
 
 
-def _chmutov(n: int) -> str:
-    """Chmutov's T_n(x) + T_n(y) + T_n(z) = 0 written out (the sweep's family): every power
-    stands alone, so its ray coefficients take raypoly's Taylor shift."""
-    import sympy
-
-    x = sympy.Symbol("x")
-    tn = " + ".join(f"({c})*x^{k}" for (k,), c in sympy.Poly(sympy.chebyshevt(n, x)).terms())
-    return " + ".join(tn.replace("x", v) for v in "xyz") + " = 0"
-
-
 def _degree_20_cases():
     from implc.targets import TARGETS, flavor_problem
 
@@ -308,7 +298,7 @@ def test_exact_at_degree_20_validates_everywhere(target, flavor, precision, kind
     from implc.validate import validate_text
 
     require_tool("glslangValidator")  # the other validators run in process (naga, PoCL)
-    surface = load_surface(equation=_chmutov(20))
+    surface = load_surface(equation=chmutov(20))
     text = emit(surface, target, "exact", None, flavor, kind,
                 "deg20_" if kind == "library" else "", precision)
     assert "Bernstein subdivision" in text
