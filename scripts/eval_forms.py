@@ -110,8 +110,9 @@ def float32_holds(surface) -> bool:
     from implc.show import float32_report
 
     degree = polynomial_degree(surface.expr)
-    return degree is None or not float32_report(surface.expr, surface.view, degree,
-                                                ).point_warns
+    if degree is None:
+        return True
+    return not float32_report(surface.expr, surface.view, degree).point_warns
 
 
 def measure_sweep(surface, size: int, frames: int, precision: str = "float") -> dict:
@@ -119,8 +120,8 @@ def measure_sweep(surface, size: int, frames: int, precision: str = "float") -> 
     median ms (the faster of COPIES compiles), the metrics against the reference, implc's
     emit seconds (in process, sympy included) and the driver's compile seconds (program
     build plus first draw, llvmpipe compiling there; the Mesa shader cache is off, see
-    main). In double, exact and taylor
-    (its `auto` form) in float32 too, in the same rounds, keyed (method, form, "float32")."""
+    main). In double, exact and taylor (its `auto` form) in float32 too, in the same
+    rounds, keyed (method, form, "float32")."""
     from implc.emit import emit
 
     reference = open_runner(surface, "reference", "", get_method("taylor").defaults,
@@ -178,8 +179,8 @@ class Row(NamedTuple):
     in_float32: float
 
 
-def _measured_row(first: str, surface, size: int, frames: int) -> tuple[dict, float, str,
-                                                                        float]:
+def _measured_row(first: str, surface, size: int,
+                  frames: int) -> tuple[dict, float, str, float]:
     """Measure `surface` (measure_sweep, in double where float32 does not hold it), print
     its table row after the cells `first`, and return the measurements, exact / taylor,
     the precision solved in and exact / taylor in float32."""
