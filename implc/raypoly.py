@@ -150,9 +150,8 @@ def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
     loop: frames 0.93-0.97 at T13-T18 in float32 with fewer wrong roots (T16 8,303 ->
     7,509 of 262,144); in double the division 0.93-0.97 at T18 and T20, the parity
     Horner 0.94-0.98 of that (0.88-0.92 of the loop), 0 / 0 / 0 kept. In float32 the
-    parity Horner put T16's
-    wrong roots at 16,719, and sums of a_e C(e, j) o^(e - j) at 26,615: their terms
-    cancel where the division's partial sums stay small."""
+    parity Horner put T16's wrong roots at 16,719, and sums of a_e C(e, j) o^(e - j) at
+    26,615: their terms cancel where the division's partial sums stay small."""
     top = max(constants)
     if precision == "float":
         p: list = [constants.get(e) for e in range(top + 1)]  # None: zero

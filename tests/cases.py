@@ -76,7 +76,6 @@ def all_golden_cases() -> list[GoldenCase]:
     return [c for target in TARGETS for c in golden_cases(target)]
 
 
-
 def chmutov(n: int) -> str:
     """Chmutov's T_n(x) + T_n(y) + T_n(z) = 0 written out, as the degree sweep writes it
     (scripts/eval_forms.py): every power stands alone, so its ray coefficients take
