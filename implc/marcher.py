@@ -54,7 +54,9 @@ from .pieces import (
     COMPONENT,
     QUANTITY_ORDER,
     RETURN_TYPE,
+    IntervalMarching,
     Marcher,
+    Marching,
     PrintedBody,
     build_programs,
     function_name,
@@ -288,17 +290,18 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
                     for c in CONSTANT_SYMBOLS if c in used)
     printed += (("int", prefix.upper() + "MAX_STEPS", str(int(constants.max_steps))),
                 ("int", prefix.upper() + "REFINE_STEPS", str(int(constants.refine_steps))))
-    monotone = False  # (interval: whether FD_range encloses F' too)
     if method.bounds:
         derivative = derivative_program(expr, max_derived)
-        monotone = derivative is not None
+        monotone = derivative is not None  # whether FD_range encloses F' too
         functions.append(range_function("FD_range", derivative, printer, prefix, carried)
                          if monotone else
                          range_function("F_range", range_program(expr), printer, prefix,
                                         carried))
         printed = range_constants(printer, prefix) + printed[-1:]  # and REFINE_STEPS
-    return Marcher(form, tuple(functions), printed, ray_fields, ray, sample, fd, step, root,
-                   interval=method.bounds, monotone=monotone, carried=carried)
+        return IntervalMarching(form, tuple(functions), printed, ray_fields, ray, carried, fd,
+                                monotone)
+    return Marching(form, tuple(functions), printed, ray_fields, ray, carried, sample, fd, step,
+                    root)
 
 
 def _apply(quantity: str, arg: sympy.Expr) -> sympy.Expr:

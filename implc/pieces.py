@@ -1,22 +1,24 @@
 """The printed pieces every lowering returns (the records templates/marcher.j2 and
 templates/solver.j2 read) and the point functions: straight-line shader functions of the
-point p (and direction d), each one jointly CSE'd Program of S's derivatives."""
+point p (and direction d), each one jointly CSE'd Program of S's derivatives.
+
+A lowering returns one variant of `Marcher`, named by its `kind`: `Marching` and
+`IntervalMarching` here, and the exact method's `solver.Solving`, which holds that
+solver's own record. Each variant has only the pieces its template prints, so this module
+needs nothing from the lowerings that build them."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import ClassVar
 
 import sympy
 
 from .derive import Derivatives
 from .optimize import Program, optimize
 from .symbols import DIRECTION, POINT
-
-if TYPE_CHECKING:
-    from .solver import Solver
 
 QUANTITY_ORDER = ("S", "dS", "d2S", "lap", "grad")
 _LETTER = {"S": "S", "dS": "D", "d2S": "H", "lap": "L"}
@@ -54,26 +56,41 @@ class PrintedBody:
 
 @dataclass(frozen=True)
 class Marcher:
-    """Everything method- and form-specific the skeleton prints."""
+    """What every lowering prints for the skeleton: its functions, constants and ray
+    record. `kind` names the variant, which templates/marcher.j2 branches on."""
 
+    kind: ClassVar[str]
     form: str
     functions: tuple[ShaderFunction, ...]
     constants: tuple[tuple[str, str, str], ...]  # (abstract type, name, printed value)
     ray_fields: tuple[tuple[str, str, str], ...]  # beyond o, d, sm: (type, name, comment)
     ray: PrintedBody  # lets of ray_of(ro, rd, sm, hr) after oc = ro + sm rd; the fields' values
-    sample: PrintedBody
-    fd: PrintedBody
-    step: PrintedBody
-    root: PrintedBody
-    solver: Solver | None = None
-    carried: tuple[tuple[str, str], ...] = ()  # see `lower`
-    interval: bool = False  # the interval march (templates/interval.j2)
-    monotone: bool = False  # interval: with F''s enclosure (FD_range), a monotonic test
+    carried: tuple[tuple[str, str], ...]  # see marcher.lower
 
     @property
     def carried_args(self) -> str:
         """", params" (the carried arguments, appended to a call), or ""."""
         return "".join(f", {name}" for _, name in self.carried)
+
+
+@dataclass(frozen=True)
+class Marching(Marcher):
+    """A march by a step rule and a root test (templates/marcher.j2's own loop)."""
+
+    kind: ClassVar[str] = "march"
+    sample: PrintedBody
+    fd: PrintedBody
+    step: PrintedBody
+    root: PrintedBody
+
+
+@dataclass(frozen=True)
+class IntervalMarching(Marcher):
+    """The `interval` method's march over F's enclosures (templates/interval.j2)."""
+
+    kind: ClassVar[str] = "interval"
+    fd: PrintedBody
+    monotone: bool  # with F''s enclosure (FD_range), a monotonic test
 
 
 # --- derivation (cached: emit asks for the same programs for every target) -----------

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from math import comb
+from typing import ClassVar
 
 import sympy
 
@@ -17,7 +18,6 @@ from .optimize import count_ops
 from .options import EXACT_MAX_DEGREE, UNIT_ROUNDOFF
 from .pieces import (
     Marcher,
-    PrintedBody,
     ShaderFunction,
     build_programs,
     point_function,
@@ -149,6 +149,14 @@ class Solver:
     first_halvings: int = 0
 
 
+@dataclass(frozen=True)
+class Solving(Marcher):
+    """The `exact` method's lowering: templates/solver.j2 in place of the march."""
+
+    kind: ClassVar[str] = "solve"
+    solver: Solver
+
+
 def _unit_roundoff(printer) -> float:
     """The unit roundoff of the precision `printer` prints in."""
     return UNIT_ROUNDOFF[printer.precision]
@@ -196,7 +204,7 @@ def _value_function(name: str, n: int, printer, prefix: str,
 
 
 def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
-                  max_derived: int, carried: tuple[tuple[str, str], ...]) -> Marcher:
+                  max_derived: int, carried: tuple[tuple[str, str], ...]) -> Solving:
     """The pieces of templates/solver.j2: S and grad at the point (shading, residual),
     the ray record with the coefficients, and P_k (k = 1..n), the (n-k)-th derivative of
     F, a degree-k polynomial in u = t - sm: by Estrin's scheme for k < n (the Newton loops
@@ -245,7 +253,6 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     bottom = 2 if n >= 3 else 1
     m = n - bottom
     closed = tuple(printer.doprint(v) for v in derivative_coefficients(n, m))
-    empty = PrintedBody((), ())
     solver = Solver(n, bottom, closed)
     if bernstein:
         # Newton starts at the zero of the root node's control polygon (the points
@@ -269,8 +276,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                 tuple(printed_lets(powers, printer)), (printer.doprint(value),)))
         printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
-    return Marcher("ray-poly", tuple(functions), printed, ray_fields, ray, empty, empty, empty,
-                   empty, solver, carried)
+    return Solving("ray-poly", tuple(functions), printed, ray_fields, ray, carried, solver)
 
 
 def descent_levels(n: int) -> tuple[tuple[int, tuple[int, ...]], ...]:

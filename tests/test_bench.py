@@ -35,8 +35,7 @@ from cases import PAPER
 from conftest import require_gl
 from PIL import Image
 
-from implc.bench import make_configs, run_bench
-from implc.bench_report import PAPER_TABLE1
+from implc.bench import PAPER_TABLE1, make_configs, run_bench
 from implc.compare import geometry_difference
 from implc.errors import InputError
 from implc.methods import METHODS

@@ -6,6 +6,9 @@ module may import from a lower layer, or from its own layer inside its own packa
 (render/run.py uses render/reference.py; a package's __init__.py, front/__init__.py, is
 inside its package); across packages the modules of one layer are
 independent (validate.py and render/ never import each other).
+
+Layers alone allow a circle inside one layer of one package (bench.py and bench_report.py
+once imported each other), so the import graph is checked for cycles too.
 """
 
 from __future__ import annotations
@@ -105,3 +108,93 @@ def test_dynamic_imports_only_in_the_target_registry():
     users = [str(p.relative_to(ROOT)) for p in sorted(PACKAGE.rglob("*.py"))
              if re.search(r"\bimportlib\b|\b__import__\b", p.read_text(encoding="utf-8"))]
     assert users == ["implc/targets.py"], users
+
+
+def import_graph() -> dict[str, dict[str, str]]:
+    """importer -> imported -> where ("implc/x.py:12"), over every import in implc/,
+    function-local and `if TYPE_CHECKING:` ones included (a circle of type-only imports is
+    still two modules that cannot be understood one without the other). `from .pkg import
+    name` imports pkg's __init__; a submodule's implicit import of its parent is not
+    counted (a package's __init__ that imports its own submodules is no circle)."""
+    files = sorted(PACKAGE.rglob("*.py"))
+    known = {module_name(p) for p in files}
+    graph: dict[str, dict[str, str]] = {module_name(p): {} for p in files}
+    for path in files:
+        importer = module_name(path)
+        for line, imported in imports(path, known):
+            if imported in known and imported != importer:
+                graph[importer].setdefault(imported, f"{path.relative_to(ROOT)}:{line}")
+    return graph
+
+
+def cycles(graph: dict[str, dict[str, str]]) -> list[list[str]]:
+    """One shortest cycle (its modules, the first repeated at the end) through each
+    strongly connected component of more than one module (Tarjan's algorithm)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    components: list[set[str]] = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        for nxt in graph.get(node, {}):
+            if nxt not in index:
+                visit(nxt)
+                low[node] = min(low[node], low[nxt])
+            elif nxt in stack:
+                low[node] = min(low[node], index[nxt])
+        if low[node] == index[node]:
+            component = set()
+            while True:
+                member = stack.pop()
+                component.add(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                components.append(component)
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    found = []
+    for component in components:
+        start = min(component)
+        paths = {start: [start]}
+        queue = [start]
+        while queue:  # breadth first, inside the component, back to `start`
+            node = queue.pop(0)
+            for nxt in sorted(graph[node]):
+                if nxt == start:
+                    found.append([*paths[node], start])
+                    queue = []
+                    break
+                if nxt in component and nxt not in paths:
+                    paths[nxt] = [*paths[node], nxt]
+                    queue.append(nxt)
+    return sorted(found)
+
+
+def describe(cycle: list[str], graph: dict[str, dict[str, str]]) -> str:
+    """implc.a -> implc.b (implc/a.py:3) -> implc.a (implc/b.py:7)."""
+    steps = zip(cycle, cycle[1:], strict=False)
+    return cycle[0] + "".join(f" -> {b} ({graph[a][b]})" for a, b in steps)
+
+
+def test_no_import_cycles():
+    """No module imports itself through others; the message names each circle's modules
+    and the lines of its imports."""
+    graph = import_graph()
+    found = cycles(graph)
+    assert not found, "import cycles in implc/:\n" + "\n".join(describe(c, graph)
+                                                              for c in found)
+
+
+def test_cycles_finds_a_circle():
+    """The finder itself: the shortest circle of a component behind a tail, and none in a
+    graph whose paths only meet again."""
+    graph = {"a": {"b": "a.py:1"}, "b": {"c": "b.py:2"},
+             "c": {"d": "c.py:3", "e": "c.py:4"}, "d": {"e": "d.py:5"}, "e": {"b": "e.py:6"}}
+    assert cycles(graph) == [["b", "c", "e", "b"]]
+    assert describe(["b", "c", "e", "b"], graph) == "b -> c (b.py:2) -> e (c.py:4) -> b (e.py:6)"
+    assert cycles({"a": {"b": "", "c": ""}, "b": {"c": ""}, "c": {}}) == []

@@ -1,28 +1,7 @@
-"""The Table 1 harness: speed and accuracy of every marcher against the exact reference.
+"""Timing a bench run: every configuration x surface x method, its frames taken in turns,
+each last frame compared with the exact reference; then the run's report is written.
 
-For each configuration x surface x method: one warm-up frame, then `frames` timed frames
-(each `runner.draw()` renders and waits for completion; the read-back of the outputs is
-not part of a frame, as it is not in an application that displays them; the methods of one
-surface take their frames in turns, see `time_interleaved`), reported as the
-median frames per second and as the ratio to `taylor`'s fps in the same run (absolute fps
-depend on the machine; the ratio is what compares across machines). The last timed frame
-is compared with the exact CPU reference (computed once per surface, same size and
-camera): SSIM, false / missed hits, wrong-root pixels, mean march steps per pixel.
-
-Configurations:
-- `paper`: each method's defaults, the paper's Table 1 constants (b = 0.01; hessian
-  b = 0.002; tau1 = tau2 = tau3 = 0.01);
-- `equal`: the same base step for every method (`equal_step`, default 0.002 = the paper's
-  hessian step), so accuracy differences come from the root test, not the step;
-- `taylor2`: hessian and hessian-approx with `taylor2 = "consistent"` (h^2/8, F''(t1) in r)
-  at the paper's constants, with taylor (which has no F'' term, so is unchanged) timed
-  again beside them: a ratio is only fair between frames taken in turns, close in time;
-- `extremum`: the same with `taylor2 = "extremum"`, implc's own test (README "The methods").
-
-Outputs in the directory: table.md, table.json, figure.png (the first configuration,
-`paper` by default, laid out like the paper's Fig. 2), figure-<config>.png for the others,
-and renders/<surface>-<method>-<config>.png (+ JSON sidecar; + EXR with `exr=True`) and
-renders/<surface>-reference.png.
+The package's docstring (implc/bench/__init__.py) says what is measured and why.
 """
 
 from __future__ import annotations
@@ -33,113 +12,21 @@ import statistics
 import sys
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
 
-from .bench_report import write_outputs
-from .errors import InputError
-from .fileio import staged_directory
-from .methods import METHODS
-from .metrics import compare
-from .progress import Progress
-from .render.result import RenderResult
-from .render.run import BACKENDS, metadata, open_runner
-from .surface import Surface
+from ..errors import InputError
+from ..fileio import staged_directory
+from ..methods import METHODS
+from ..metrics import compare
+from ..progress import Progress
+from ..render.result import RenderResult
+from ..render.run import BACKENDS, metadata, open_runner
+from ..surface import Surface
+from .records import CONFIG_NAMES, DEFAULT_METHODS, EQUAL_STEP, BenchRun, Cell, make_configs
+from .report import write_outputs
 
-# Table 1's columns in the paper's order, then `sign` (not in the paper; informative) and
-# `exact` (implc's root isolation, beyond the paper).
-DEFAULT_METHODS: tuple[str, ...] = ("taylor", "curvature", "hessian-approx", "hessian", "sign",
-                                    "exact")
-CONFIG_NAMES: tuple[str, ...] = ("paper", "equal", "taylor2", "extremum")
-EQUAL_STEP = 0.002  # the paper's hessian step, given to every method in `equal`
 TILE = 256  # figure tile size in pixels
-
-
-@dataclass(frozen=True)
-class BenchConfig:
-    """A set of constant overrides and the methods they are measured on."""
-
-    name: str
-    title: str
-    overrides: Mapping[str, object]
-    methods: tuple[str, ...] | None = None  # None: every selected method
-
-    def applies_to(self, selected: Sequence[str]) -> list[str]:
-        return [m for m in selected if self.methods is None or m in self.methods]
-
-
-def make_configs(names: Sequence[str], equal_step: float = EQUAL_STEP) -> list[BenchConfig]:
-    """The named configurations, in the order given (see the module docstring)."""
-    known = {
-        "paper": BenchConfig(
-            "paper", "the paper's constants: b = 0.01 (hessian 0.002), tau1 = tau2 = tau3 = 0.01",
-            {}),
-        "equal": BenchConfig(
-            "equal", f"equal step: b = {equal_step:g} for every method, tau as in the paper",
-            {"step": equal_step}),
-        "taylor2": BenchConfig(
-            "taylor2", "Eq. 4 consistent (h^2/8, F''(t1) in r) at the paper's constants; "
-            "taylor is unaffected and re-timed as the fps baseline",
-            {"taylor2": "consistent"}, methods=("taylor", "hessian-approx", "hessian", "exact")),
-        "extremum": BenchConfig(
-            "extremum", "implc's extremum test (consistent Eq. 4 plus the extremum of each "
-            "end's quadratic model) at the paper's constants; taylor re-timed as the baseline",
-            {"taylor2": "extremum"}, methods=("taylor", "hessian-approx", "hessian", "exact")),
-    }
-    configs = []
-    for name in names:
-        if name not in known:
-            raise InputError(f"unknown configuration '{name}'; choose from {', '.join(known)}")
-        if name not in (c.name for c in configs):
-            configs.append(known[name])
-    return configs
-
-
-@dataclass
-class Cell:
-    """One surface x method x configuration measurement."""
-
-    fps: float
-    frame_seconds: list[float]
-    setup_seconds: float  # implc's emit and the driver's program build
-    compile_seconds: float  # the program's first use, where llvmpipe compiles it
-    metrics: dict
-    render: str  # PNG path relative to the output directory
-    ratio_to_taylor: float | None = None
-
-    def as_json(self) -> dict:
-        return {
-            "fps": self.fps,
-            "ratio_to_taylor": self.ratio_to_taylor,
-            "frame_seconds": self.frame_seconds,
-            "setup_seconds": self.setup_seconds,
-            "compile_seconds": self.compile_seconds,
-            **self.metrics,
-            "render": self.render,
-        }
-
-
-@dataclass
-class BenchRun:
-    """Everything measured (bench_report.table_json(run) is table.json)."""
-
-    size: int
-    frames: int
-    backend: str
-    methods: list[str]
-    configs: list[BenchConfig]
-    surfaces: dict[str, Surface]
-    machine: dict
-    reference_seconds: dict[str, float] = field(default_factory=dict)
-    cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)  # (config, surf, m)
-    baseline: bool = False  # time the hand-written programs too (implc/baseline.py)
-    # the hand-written programs, timed in turns with the generated ones
-    baseline_cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)
-    tiles: dict[tuple[str, str, str], object] = field(default_factory=dict)  # PIL thumbnails
-
-    def config_methods(self, config: BenchConfig) -> list[str]:
-        return config.applies_to(self.methods)
 
 
 def machine_info(backend: str) -> dict:
@@ -152,7 +39,7 @@ def machine_info(backend: str) -> dict:
         "load_average_start": _load_average(),  # other work on the machine skews fps
     }
     if backend == "gl":
-        from .render.gl import renderer_name
+        from ..render.gl import renderer_name
 
         info["gl_renderer"] = renderer_name()
     return info
@@ -241,8 +128,8 @@ def run_bench(
 
 def _measure(surfaces, out_dir: Path, size, methods, frames, backend, bench_configs, exr,
              progress, baseline: bool = False) -> BenchRun:
-    from .figure import tile_image
-    from .render.image_io import write_render
+    from ..figure import tile_image
+    from ..render.image_io import write_render
 
     renders = out_dir / "renders"
     renders.mkdir(parents=True, exist_ok=True)
@@ -279,9 +166,9 @@ def _measure(surfaces, out_dir: Path, size, methods, frames, backend, bench_conf
 
 
 def _measure_surface(run, config, chosen, key, surface, reference, renders, exr, bar) -> None:
-    from .baseline import has_baseline, open_baseline_runner
-    from .figure import tile_image
-    from .render.image_io import write_render
+    from ..baseline import has_baseline, open_baseline_runner
+    from ..figure import tile_image
+    from ..render.image_io import write_render
 
     size, backend = run.size, run.backend
     constants = [METHODS[m].constants(**config.overrides) for m in chosen]

@@ -1,23 +1,19 @@
 """The Table 1 harness's outputs: table.md, table.json and the figures, from a `BenchRun`.
 
-Reporting only: what was measured is `bench.py`'s (a `BenchRun`); this module formats it,
-compares it with the paper's own Table 1, and writes the files.
+Reporting only: what was measured is `measure.py`'s (a `BenchRun`, records.py); this
+module formats it, compares it with the paper's own Table 1, and writes the files.
 """
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from . import __version__
-from .fileio import write_atomic, write_with
-from .methods import METHODS
-from .metrics import T_TOL
-
-if TYPE_CHECKING:
-    from .bench import BenchConfig, BenchRun, Cell
-
+from .. import __version__
+from ..fileio import write_atomic, write_with
+from ..methods import METHODS
+from ..metrics import T_TOL
+from .records import BenchConfig, BenchRun, Cell
 
 # The paper's Table 1 (NVidia Quadro P5000, 1024x1024): fps and SSIM as printed. The
 # Hessian-exact column has no SSIM: it is the paper's own ground truth (at a tiny step).
@@ -87,7 +83,7 @@ def write_outputs(run: BenchRun, out_dir: Path) -> list[Path]:
 
 def build_figure(run: BenchRun, config: BenchConfig):
     """Rows = surfaces, columns = the configuration's methods + the reference (Fig. 2)."""
-    from .figure import grid_figure
+    from ..figure import grid_figure
 
     methods = run.config_methods(config)
     columns = [*methods, "reference"]
