@@ -126,9 +126,9 @@ corpus-interval: setup
 compile-times: setup
 	$(PY) scripts/compile_times.py -j 2
 
-# Start-up time of `implc --help`, `COMMAND --help`, `--version` (goal: under 0.15 s; no
-# sympy or numpy is imported for them) and of `list` and `show` for comparison: medians
-# of 7 fresh processes each, as a table. About 30 s.
+# Start-up time of `import implc` beside `implc --help`, of `COMMAND --help` and `--version`
+# (goal: under 0.15 s; no sympy or numpy is imported for them) and of `list` and `show`
+# for comparison: medians of 7 fresh processes each, as a table. About 30 s.
 startup: setup
 	$(PY) scripts/startup.py
 

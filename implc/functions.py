@@ -23,10 +23,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import numpy as np
 import sympy
 from sympy import Max, Min, Piecewise, floor, pi
+
+if TYPE_CHECKING:  # numpy loads when a row is evaluated: compiling needs none (issue 43)
+    import numpy as np
 
 # An interval rule: the argument's enclosure (lo, hi), as sympy symbols, and `let` (a value
 # -> a symbol naming it, for a value used twice) -> the function's enclosure over it
@@ -79,8 +82,28 @@ class Function:
     printed: str = "call"
 
 
+def _np(name: str) -> Callable[..., np.ndarray]:
+    """numpy.<name>, looked up when called: the table is read by the compile path, which
+    must not import numpy (issue 43: Pyodide), only the CPU evaluator calls it."""
+    def call(*args, **kwargs):
+        import numpy
+
+        return getattr(numpy, name)(*args, **kwargs)
+
+    call.__name__ = call.__qualname__ = f"numpy.{name}"
+    return call
+
+
 def _heaviside(x, *_):
+    import numpy as np
+
     return np.where(x > 0, 1.0, np.where(x < 0, 0.0, 0.5))
+
+
+def _zero(x, *_):
+    import numpy as np
+
+    return np.zeros_like(x)
 
 
 def _increasing(f):
@@ -149,45 +172,48 @@ def _log(lo, hi, let):
 
 
 FUNCTIONS: tuple[Function, ...] = (
-    Function("sin", 1, sympy.sin, "sin", np.sin, "radians",
+    Function("sin", 1, sympy.sin, "sin", _np("sin"), "radians",
              interval=_periodic(sympy.sin, pi / 2), error=(8, 2.0**-21)),
-    Function("cos", 1, sympy.cos, "cos", np.cos, "radians",
+    Function("cos", 1, sympy.cos, "cos", _np("cos"), "radians",
              interval=_periodic(sympy.cos, 0), error=(8, 2.0**-21)),
-    Function("tan", 1, sympy.tan, "tan", np.tan, "radians", interval=_tan, error=(16, 2.0**-21)),
-    Function("asin", 1, sympy.asin, "asin", np.arcsin, "domain [-1, 1]",
+    Function("tan", 1, sympy.tan, "tan", _np("tan"), "radians", interval=_tan,
+             error=(16, 2.0**-21)),
+    Function("asin", 1, sympy.asin, "asin", _np("arcsin"), "domain [-1, 1]",
              interval=_on_domain(sympy.asin, -1, 1), error=(16, 2.0**-10), aliases=("arcsin",)),
-    Function("acos", 1, sympy.acos, "acos", np.arccos, "domain [-1, 1]",
+    Function("acos", 1, sympy.acos, "acos", _np("arccos"), "domain [-1, 1]",
              interval=_on_domain(sympy.acos, -1, 1, increasing=False), error=(16, 2.0**-11),
              aliases=("arccos",)),
-    Function("atan", 1, sympy.atan, "atan", np.arctan, "range (-pi/2, pi/2)",
+    Function("atan", 1, sympy.atan, "atan", _np("arctan"), "range (-pi/2, pi/2)",
              interval=_increasing(sympy.atan), error=(16, 2.0**-18), aliases=("arctan",)),
     # atan2 has no interval rule (its branch cut): -m interval refuses it
-    Function("atan2", 2, sympy.atan2, "atan2", np.arctan2, "atan2(y, x), angle of (x, y)",
+    Function("atan2", 2, sympy.atan2, "atan2", _np("arctan2"), "atan2(y, x), angle of (x, y)",
              aliases=("arctan2",)),
-    Function("sinh", 1, sympy.sinh, "sinh", np.sinh, "", interval=_increasing(sympy.sinh),
+    Function("sinh", 1, sympy.sinh, "sinh", _np("sinh"), "", interval=_increasing(sympy.sinh),
              error=(16, 2.0**-21), aliases=("sh",), grows=True),
-    Function("cosh", 1, sympy.cosh, "cosh", np.cosh, "", interval=_even(sympy.cosh),
+    Function("cosh", 1, sympy.cosh, "cosh", _np("cosh"), "", interval=_even(sympy.cosh),
              error=(16, 0), aliases=("ch",), grows=True),
-    Function("tanh", 1, sympy.tanh, "tanh", np.tanh, "", interval=_increasing(sympy.tanh),
+    Function("tanh", 1, sympy.tanh, "tanh", _np("tanh"), "", interval=_increasing(sympy.tanh),
              error=(16, 2.0**-21), aliases=("th",)),
-    Function("exp", 1, sympy.exp, "exp", np.exp, "", interval=_increasing(sympy.exp),
+    Function("exp", 1, sympy.exp, "exp", _np("exp"), "", interval=_increasing(sympy.exp),
              error=(16, 0), grows=True),
-    Function("log", 1, sympy.log, "log", np.log, "natural logarithm; x > 0", interval=_log,
+    Function("log", 1, sympy.log, "log", _np("log"), "natural logarithm; x > 0", interval=_log,
              error=(16, 2.0**-21), aliases=("ln",)),
-    Function("sqrt", 1, sympy.sqrt, "sqrt", np.sqrt, "x >= 0; NaN (no surface) below",
+    Function("sqrt", 1, sympy.sqrt, "sqrt", _np("sqrt"), "x >= 0; NaN (no surface) below",
              interval=_on_domain(sympy.sqrt, 0), error=(4, 0), root_degree=2),
     # Sugar: builds sign(a)*|a|^(1/3) from other rows, so no node of its own reaches a printer.
     Function("cbrt", 1, lambda a: sympy.sign(a) * sympy.Abs(a) ** sympy.Rational(1, 3), None,
-             np.cbrt, "real cube root, defined for negative x (same as x^(1/3))", root_degree=3),
-    Function("abs", 1, sympy.Abs, "Abs", np.abs, "derivative sign(x)", interval=_abs,
+             _np("cbrt"), "real cube root, defined for negative x (same as x^(1/3))",
+             root_degree=3),
+    Function("abs", 1, sympy.Abs, "Abs", _np("abs"), "derivative sign(x)", interval=_abs,
              aliases=("fabs",), branch_derivative=sympy.sign),
-    Function("sign", 1, sympy.sign, "sign", np.sign, "-1, 0 or 1; derivative 0",
+    Function("sign", 1, sympy.sign, "sign", _np("sign"), "-1, 0 or 1; derivative 0",
              interval=lambda lo, hi, let: (sympy.sign(lo), sympy.sign(hi), sympy.false),
              aliases=("sgn",), branch_derivative=lambda u: 2 * sympy.DiracDelta(u)),
     # min and max take their arguments' bounds apart (implc/interval.py)
-    Function("min", 2, sympy.Min, "Min", np.minimum, "smooth union in CSG; derivative by branch",
-             variadic=True, unevaluated=True, aliases=("fmin",), printed="fold"),
-    Function("max", 2, sympy.Max, "Max", np.maximum, "derivative by branch", variadic=True,
+    Function("min", 2, sympy.Min, "Min", _np("minimum"),
+             "smooth union in CSG; derivative by branch", variadic=True, unevaluated=True,
+             aliases=("fmin",), printed="fold"),
+    Function("max", 2, sympy.Max, "Max", _np("maximum"), "derivative by branch", variadic=True,
              unevaluated=True, aliases=("fmax",), printed="fold"),
     # Only in derivatives: the step of min/max/abs and the (ignored) spike of sign.
     Function("step", 1, sympy.Heaviside, "Heaviside", _heaviside,
@@ -197,11 +223,11 @@ FUNCTIONS: tuple[Function, ...] = (
              "as large (Newton is safeguarded)", user=False,
              interval=lambda lo, hi, let: (sympy.Heaviside(lo), sympy.Heaviside(hi),
                                            sympy.false), printed="step"),
-    Function("delta", 1, sympy.DiracDelta, "DiracDelta", lambda x, *_: np.zeros_like(x),
+    Function("delta", 1, sympy.DiracDelta, "DiracDelta", _zero,
              "derivative of sign(x); taken as 0 (almost everywhere)", user=False,
              printed="zero"),
     # Only in interval rules (sin, cos, tan: which period an end lies in).
-    Function("floor", 1, sympy.floor, "floor", np.floor, "largest integer <= x", user=False),
+    Function("floor", 1, sympy.floor, "floor", _np("floor"), "largest integer <= x", user=False),
 )
 
 USER_FUNCTIONS: dict[str, Function] = {f.name: f for f in FUNCTIONS if f.user}

@@ -15,10 +15,12 @@ up = right x forward.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:  # numpy loads with the CPU reference and framing, never to compile
+    import numpy as np
 
 Vec3 = tuple[float, float, float]
 
@@ -204,6 +206,8 @@ def apply_view(
     target = pick(options.target, view.target if "target" in given else center)
     eye = pick(options.eye, view.eye)
     if placed_eye:
+        import numpy as np
+
         aim = np.asarray(target, dtype=np.float64)
         off_centre = float(np.linalg.norm(np.asarray(center) - aim))
         point = aim + (off_centre + fit_distance(radius, fov, aspect)) * frame_direction(up)
@@ -218,6 +222,8 @@ def apply_view(
 def frame_direction(up: Vec3) -> np.ndarray:
     """FRAME_DIRECTION (unit) turned by the rotation that takes +y to `up`: the same
     three-quarter view, whichever way is up ((3, -4, 2) for up = +z)."""
+    import numpy as np
+
     a = np.array([0.0, 1.0, 0.0])
     b = np.asarray(up, dtype=np.float64) / np.linalg.norm(up)
     d = np.asarray(FRAME_DIRECTION) / np.linalg.norm(FRAME_DIRECTION)
@@ -271,19 +277,19 @@ def view_problems(view: View) -> list[tuple[str, str]]:
     if not view.clip_radius > 0.0:
         problems.append(("radius", f"radius = {view.clip_radius:g}: the clip sphere needs a "
                                    "positive radius, e.g. radius = 1.5"))
-    eye, target, up = (np.asarray(v, dtype=np.float64) for v in (view.eye, view.target, view.up))
-    distance = float(np.linalg.norm(target - eye))
-    if distance <= 1e-9 * max(1.0, float(np.abs(eye).max())):
+    eye, target, up = (_floats(v) for v in (view.eye, view.target, view.up))
+    distance = _length(_sub(target, eye))
+    if distance <= 1e-9 * max(1.0, *(abs(c) for c in eye)):
         problems.append(("target", f"eye and target are the same point {_vec(view.eye)}: the "
                                    "camera has no direction; move `target` to what it "
                                    "should look at (e.g. the clip sphere's centre)"))
         return problems
-    forward = (target - eye) / distance
-    up_length = float(np.linalg.norm(up))
+    forward = _over(_sub(target, eye), distance)
+    up_length = _length(up)
     if up_length == 0.0:
         problems.append(("up", f"up = {_vec(view.up)} has no direction; use "
                                f"up = {_vec(suggest_up(forward))}"))
-    elif float(np.linalg.norm(np.cross(forward, up / up_length))) < PARALLEL_SINE:
+    elif _length(_cross(forward, _over(up, up_length))) < PARALLEL_SINE:
         problems.append(("up", f"up = {_vec(view.up)} is parallel to the view direction "
                                f"(eye {_vec(view.eye)} to target {_vec(view.target)}), so "
                                "the picture has no 'up'; choose an up perpendicular to "
@@ -304,9 +310,9 @@ def frame_problem(view: View, width: int, height: int) -> str | None:
     return _sphere_outside(view, width / height)
 
 
-def suggest_up(forward: np.ndarray) -> tuple[float, float, float]:
+def suggest_up(forward: Sequence[float]) -> Vec3:
     """The world axis least aligned with `forward` (positive direction): a usable up hint."""
-    axis = int(np.argmin(np.abs(forward)))
+    axis = min(range(3), key=lambda i: abs(forward[i]))  # the first, as numpy's argmin
     return tuple(1.0 if i == axis else 0.0 for i in range(3))  # type: ignore[return-value]
 
 
@@ -315,21 +321,24 @@ def _sphere_outside(view: View, aspect: float | None) -> str | None:
     side of the frustum), as a message with a fix; None when part of it may be seen.
 
     aspect None: only what holds at every aspect ratio (behind, above, below)."""
-    forward, right, up = camera_basis(view)
-    offset = np.asarray(view.clip_center, dtype=np.float64) - np.asarray(view.eye)
+    forward, right, up = camera_axes(view)
+    offset = _sub(_floats(view.clip_center), _floats(view.eye))
     radius = view.clip_radius
+
+    def tilt(angle: float, side: Vec3, sign: float) -> Vec3:
+        """-sin(angle) forward +- cos(angle) side: the outward normal of a frustum plane."""
+        return _add(_scale(-math.sin(angle), forward), _scale(sign * math.cos(angle), side))
+
     half_v = math.radians(view.fov_y_deg) / 2.0
-    planes = [("behind the camera", -forward),
-              ("above the picture", -math.sin(half_v) * forward + math.cos(half_v) * up),
-              ("below the picture", -math.sin(half_v) * forward - math.cos(half_v) * up)]
+    planes = [("behind the camera", _scale(-1.0, forward)),
+              ("above the picture", tilt(half_v, up, 1.0)),
+              ("below the picture", tilt(half_v, up, -1.0))]
     if aspect is not None:
         half_h = math.atan(math.tan(half_v) * aspect)
-        planes += [("right of the picture",
-                    -math.sin(half_h) * forward + math.cos(half_h) * right),
-                   ("left of the picture",
-                    -math.sin(half_h) * forward - math.cos(half_h) * right)]
+        planes += [("right of the picture", tilt(half_h, right, 1.0)),
+                   ("left of the picture", tilt(half_h, right, -1.0))]
     for where, normal in planes:
-        if float(np.dot(normal, offset)) > radius:
+        if _dot(normal, offset) > radius:
             return (f"the clip sphere (centre {_vec(view.clip_center)}, radius {radius:g}) is "
                     f"entirely {where}: the render would be blank; point `target` at it "
                     f"(e.g. target = {_vec(view.clip_center)}), move `eye`, or widen `fov`")
@@ -340,31 +349,86 @@ def _vec(v) -> str:
     return "[" + ", ".join(f"{float(x):g}" for x in v) + "]"
 
 
+# 3-vector arithmetic in plain Python for what compiling reads (the camera, the lights, the
+# view checks): the compile path imports no numpy (issue 43: Pyodide). Each operation
+# rounds as numpy's elementwise one does, and `_length` sums x^2 + y^2 + z^2 left to right
+# as numpy's `norm(v, axis=-1)` (`normalize`) does, so the shaders' literals are the bits
+# the numpy version printed.
+
+def _floats(v: Sequence[float]) -> Vec3:
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def _add(a: Vec3, b: Vec3) -> Vec3:
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def _sub(a: Vec3, b: Vec3) -> Vec3:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _scale(k: float, a: Vec3) -> Vec3:
+    return (k * a[0], k * a[1], k * a[2])
+
+
+def _dot(a: Vec3, b: Vec3) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _length(a: Vec3) -> float:
+    return math.sqrt(_dot(a, a))
+
+
+def _cross(a: Vec3, b: Vec3) -> Vec3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _over(a: Vec3, k: float) -> Vec3:
+    return (a[0] / k, a[1] / k, a[2] / k)
+
+
+def _unit(a: Vec3) -> Vec3:
+    """a / |a|, and a zero vector unchanged (as `normalize`)."""
+    n = _length(a)
+    return _over(a, 1.0 if n == 0.0 else n)
+
+
 def normalize(v: np.ndarray) -> np.ndarray:
+    import numpy as np
+
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     return v / np.where(n == 0.0, 1.0, n)
 
 
+def camera_axes(view: View) -> tuple[Vec3, Vec3, Vec3]:
+    """(forward, right, up) unit vectors of the camera, as plain floats."""
+    forward = _unit(_sub(_floats(view.target), _floats(view.eye)))
+    right = _unit(_cross(forward, _floats(view.up)))
+    return forward, right, _cross(right, forward)
+
+
 def camera_basis(view: View) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(forward, right, up) unit vectors of the camera."""
-    forward = normalize(np.subtract(view.target, view.eye).astype(np.float64))
-    right = normalize(np.cross(forward, np.asarray(view.up, dtype=np.float64)))
-    up = np.cross(right, forward)
-    return forward, right, up
+    """(forward, right, up) unit vectors of the camera, as numpy arrays (the reference)."""
+    import numpy as np
+
+    forward, right, up = camera_axes(view)
+    return np.array(forward), np.array(right), np.array(up)
 
 
-def light_directions(view: View, shading: Shading = SHADING) -> list[np.ndarray]:
+def light_directions(view: View, shading: Shading = SHADING) -> list[Vec3]:
     """World-space unit vectors towards each light of `shading` for this camera."""
-    forward, right, up = camera_basis(view)
+    forward, right, up = camera_axes(view)
     result = []
     for light in shading.lights:
-        x, y, z = light.direction
-        result.append(normalize(x * right + y * up - z * forward))
+        x, y, z = (float(c) for c in light.direction)
+        result.append(_unit(_sub(_add(_scale(x, right), _scale(y, up)), _scale(z, forward))))
     return result
 
 
 def pixel_rays(view: View, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     """Ray origins and unit directions, arrays of shape (height, width, 3), row 0 on top."""
+    import numpy as np
+
     forward, right, up = camera_basis(view)
     tan_half = math.tan(math.radians(view.fov_y_deg) / 2.0)
     i = np.arange(width, dtype=np.float64)
@@ -385,6 +449,8 @@ def clip_sphere(
 
     t_near is clamped to 0 when the eye is inside the sphere.
     """
+    import numpy as np
+
     oc = origins - np.asarray(center, dtype=np.float64)
     b = np.sum(oc * dirs, axis=-1)
     c = np.sum(oc * oc, axis=-1) - radius * radius
@@ -402,12 +468,15 @@ def shade(
     shading: Shading = SHADING,
 ) -> np.ndarray:
     """Colour (H, W, 3) in [0, 1] from the surface gradient at each hit point."""
+    import numpy as np
+
     n = normalize(grad)
     facing = np.sum(n * dirs, axis=-1, keepdims=True)
     base = np.where(facing < 0.0, np.asarray(shading.front), np.asarray(shading.back))
     n = np.where(facing < 0.0, n, -n)  # two-sided: the normal faces the viewer
     color = shading.ambient * base
     for light, ldir in zip(shading.lights, light_directions(view, shading), strict=True):
+        ldir = np.asarray(ldir)
         diffuse = np.maximum(np.sum(n * ldir, axis=-1, keepdims=True), 0.0)
         half = normalize(ldir - dirs)
         spec = np.maximum(np.sum(n * half, axis=-1, keepdims=True), 0.0) ** shading.shininess

@@ -41,6 +41,21 @@ def test_importing_the_cli_loads_no_sympy_or_numpy():
     assert heavy_modules() == []
 
 
+GPU_STACKS = ("moderngl", "glcontext", "wgpu", "pyopencl")
+
+
+def test_import_implc_loads_no_sympy_numpy_jinja2_or_gpu_stack():
+    """`import implc` stays cheap (issue 43): the library's names load on first use.
+    (`make startup` times it beside `implc --help`.)"""
+    probe = ("import json, sys, implc\n"
+             "print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in "
+             f"{set(HEAVY + GPU_STACKS)!r})))")
+    proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout.strip().splitlines()[-1]) == []
+
+
 @pytest.mark.parametrize("argv", [
     ["--help"], ["--version"], ["compile", "--help"], ["render", "--help"],
     ["show", "--help"], ["view", "--help"], ["bench", "--help"], ["corpus", "--help"],
