@@ -149,7 +149,8 @@ def row_surface(row: Row, limits=None):
 
     Raises `InputError` with the reason when implc refuses the row.
     """
-    from .surface import equation_words, load_surface
+    from .loaders import load_surface
+    from .loaders.common import equation_words
 
     args = []
     named = equation_words(row.equation)

@@ -24,12 +24,13 @@ from .emit import render_template
 from .errors import ImplcError
 from .extent import SEARCHED, locate_surface
 from .fileio import staged_directory, write_atomic
+from .loaders import load_surface
 from .marcher import default_method
 from .methods import get_method
 from .progress import Progress
 from .render.run import render
 from .scene import ViewOptions, apply_view, frame_problem
-from .surface import Surface, load_surface
+from .surface import Surface
 from .view import viewer_page
 
 SHEET_COLUMNS = 6  # cells per row of contact-sheet.png

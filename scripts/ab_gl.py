@@ -17,8 +17,8 @@ import time
 from pathlib import Path
 
 from implc.emit import render_template
+from implc.loaders import load_surface
 from implc.render.gl import GlRunner
-from implc.surface import load_surface
 
 
 def main() -> None:

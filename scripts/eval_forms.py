@@ -33,11 +33,11 @@ os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "true")  # compile times are 
 
 from implc.bench import time_interleaved  # noqa: E402
 from implc.derive import polynomial_degree  # noqa: E402
+from implc.loaders import load_surface  # noqa: E402
 from implc.marcher import choose_form  # noqa: E402
 from implc.methods import get_method  # noqa: E402
 from implc.metrics import compare  # noqa: E402
 from implc.render.run import open_runner  # noqa: E402
-from implc.surface import load_surface  # noqa: E402
 
 FORMS = ("point", "ray-poly")
 # The sweep compiles each program COPIES times and times them all in the same rounds,

@@ -24,9 +24,9 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 from eval_forms import sweep_equations  # noqa: E402
 
+from implc.loaders import load_surface  # noqa: E402
 from implc.methods import get_method  # noqa: E402
 from implc.render.run import render  # noqa: E402
-from implc.surface import load_surface  # noqa: E402
 
 WRONG = 1e-3  # a root this far from double's is wrong (implc.metrics' measure)
 

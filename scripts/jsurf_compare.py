@@ -26,11 +26,11 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from implc.jsurf import to_jsurf
+from implc.loaders import load_surface
+from implc.loaders.jsurf_write import to_jsurf
 from implc.marcher import default_method
 from implc.methods import get_method
 from implc.render.run import render
-from implc.surface import load_surface
 
 
 def jsurf_hits(jsurf: list[str], text: str, size: int, work: Path) -> np.ndarray:

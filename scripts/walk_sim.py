@@ -19,6 +19,7 @@ import numpy as np
 from scipy.special import comb
 
 from implc.conditioning import DIRECTION, POINT, clip_sphere, pixel_rays
+from implc.loaders import load_surface
 from implc.numeric import evaluate_program
 from implc.raypoly import coefficient_program
 from implc.solver import (
@@ -32,7 +33,6 @@ from implc.solver import (
     NEXT_REACH,
     descent_levels,
 )
-from implc.surface import load_surface
 
 MIN_WIDTH = 2.0 ** -BERNSTEIN_DEPTH
 

@@ -14,10 +14,10 @@ import pytest
 from conftest import require_gl, require_tool
 
 from implc.baseline import BASELINES, baseline_program, open_baseline_runner
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.render.run import render
-from implc.surface import load_surface
 from implc.validate import validate_glsl
 
 SIZE = 96

@@ -38,10 +38,10 @@ from PIL import Image
 from implc.bench import PAPER_TABLE1, make_configs, run_bench
 from implc.compare import geometry_difference
 from implc.errors import InputError
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.render.run import render, render_surface
-from implc.surface import load_surface
 
 ROOT = Path(__file__).resolve().parent.parent
 COUNTS = ("false_hits", "missed_hits", "wrong_root")

@@ -34,11 +34,11 @@ from browser_support import (
 from conftest import _require
 
 from implc.emit import emit, param_uniforms, render_template
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.render.run import render
 from implc.render.wgpu_runner import _uniforms
 from implc.scene import SHADING, pixel_rays
-from implc.surface import load_surface
 
 SMALL = 128
 SSIM_SAME = 0.99

@@ -186,7 +186,8 @@ def test_a_param_only_in_a_constant_exponent_or_beside_a_number_counts_as_used(t
 
 
 def test_every_bundled_example_uses_its_params():
-    from implc.surface import example_paths, load_surface
+    from implc.loaders import load_surface
+    from implc.surface import example_paths
 
     for name in example_paths():
         load_surface(name)  # raises on an unused [params] entry
@@ -282,8 +283,8 @@ def test_what_a_method_reads_is_what_changes_its_shader(method):
     """Method.reads (the warning's data) is exactly the set of constants whose value
     changes the method's shader (a quartic: ray-poly is auto's form)."""
     from implc.emit import emit
+    from implc.loaders import load_surface
     from implc.methods import METHODS
-    from implc.surface import load_surface
 
     surface = load_surface(equation="x^4 + y^4 + z^4 - 1")
     meth = METHODS[method]
@@ -339,10 +340,10 @@ def test_auto_takes_the_form_whose_march_step_costs_less(spec, method, form):
     """`--eval auto` is the form with fewer operations a march step (implc show prints
     both), and the program it emits is that form's."""
     from implc.emit import emit
+    from implc.loaders import load_surface
     from implc.marcher import choose_form, step_ops
     from implc.methods import METHODS
     from implc.options import FORMS
-    from implc.surface import load_surface
 
     surface = load_surface(equation=spec) if "=" in spec or "^" in spec else load_surface(spec)
     meth = METHODS[method]
@@ -359,10 +360,10 @@ def test_auto_keeps_point_above_its_degree_bound():
     from the ray's coefficients multiplied taylor's and hessian's bad pixels."""
     import sympy
 
+    from implc.loaders import load_surface
     from implc.marcher import choose_form, step_ops
     from implc.methods import METHODS
     from implc.options import AUTO_RAY_POLY_MAX_DEGREE
-    from implc.surface import load_surface
 
     for degree in (AUTO_RAY_POLY_MAX_DEGREE, AUTO_RAY_POLY_MAX_DEGREE + 2):
         t = sympy.Poly(sympy.chebyshevt(degree, sympy.Symbol("x")))

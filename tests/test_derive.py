@@ -11,11 +11,11 @@ from cases import EXAMPLES
 from implc.derive import Derivatives
 from implc.emit import build_functions, emit, function_quantities
 from implc.functions import FUNCTIONS
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.numeric import evaluate, evaluate_program
 from implc.optimize import _sums_by_depth, arrange_by_depth
 from implc.raypoly import estrin, estrin_derivative, weighted_coefficients
-from implc.surface import load_surface
 from implc.symbols import DIRECTION, POINT
 from implc.targets import get_target
 

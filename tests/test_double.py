@@ -11,10 +11,10 @@ from conftest import require_backend, require_validator
 from implc.backends.glsl import GlslPrinter
 from implc.emit import emit
 from implc.errors import InputError
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.render.run import render
-from implc.surface import load_surface
 from implc.symbols import X
 
 # Chmutov's T12(x) + T12(y) + T12(z) = 0, written out as users write it: coefficients up

@@ -22,10 +22,10 @@ from gl_rays import intersect
 from implc.derive import polynomial_degree
 from implc.emit import emit
 from implc.errors import InputError
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.render.run import render
-from implc.surface import load_surface
 
 SIZE = 96
 POLYNOMIAL = [e for e in EXAMPLES if polynomial_degree(load_surface(e).expr) is not None]

@@ -22,8 +22,9 @@ import numpy as np
 import pytest
 import sympy
 
+from implc.loaders import load_surface
 from implc.scene import View, camera_basis
-from implc.surface import example_paths, load_surface
+from implc.surface import example_paths
 
 # the framing API (new with issue 23), imported per test so that the command-line tests
 # below run, and fail, against a tree without it

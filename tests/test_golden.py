@@ -11,8 +11,8 @@ from cases import all_golden_cases
 from conftest import check_golden, require_validator
 
 from implc.emit import emit
+from implc.loaders import load_surface
 from implc.methods import METHODS
-from implc.surface import load_surface
 from implc.targets import TARGETS
 
 GOLDEN = Path(__file__).parent / "golden"

@@ -348,7 +348,7 @@ def test_over_large_valid_inputs_stop_before_differentiating(equation, monkeypat
     from implc.derive import derive_limits
     from implc.emit import emit
     from implc.errors import LimitError
-    from implc.surface import load_surface
+    from implc.loaders import load_surface
 
     surface = load_surface(equation=equation)
     derived = []  # the bound on work: sympy differentiates nothing before the refusal

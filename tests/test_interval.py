@@ -25,11 +25,11 @@ from implc.cli import main
 from implc.derive import polynomial_degree
 from implc.errors import InputError
 from implc.interval import DIRECTION, ORIGIN, TINY, ULP, WIDENING, A, B, range_program
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.numeric import evaluate, evaluate_program
 from implc.render.run import render
-from implc.surface import load_surface
 from implc.symbols import POINT
 
 NON_POLYNOMIAL = [e for e in EXAMPLES if polynomial_degree(load_surface(e).expr) is None]

@@ -19,9 +19,10 @@ import pytest
 import sympy
 
 from implc.front import param_symbol
-from implc.jsurf import ORTHO_DISTANCE, to_jsurf
+from implc.loaders import load_surface
+from implc.loaders.jsurf_read import ORTHO_DISTANCE
+from implc.loaders.jsurf_write import to_jsurf
 from implc.scene import SHADING, camera_basis
-from implc.surface import load_surface
 from implc.symbols import X, Y, Z
 
 DATA = Path(__file__).parent / "data" / "jsurf"
@@ -109,7 +110,9 @@ def test_perspective_export_shears_the_window(tmp_path):
     """A perspective view is written in the form jsurf 0.4.1 draws centred: its
     camera_transform maps the window jsurf spans, (t, t, -1) to (3t, 3t, -1), onto the
     centred one, (-t, -t, -1) to (t, t, -1)."""
-    from implc.jsurf import Properties, _jsurf041_tan, _matrix
+    from implc.loaders.jsurf_properties import Properties
+    from implc.loaders.jsurf_read import _matrix
+    from implc.loaders.jsurf_read import jsurf041_tan as _jsurf041_tan
 
     text = to_jsurf(load_surface("torus"))
     props = Properties("torus.jsurf", text)

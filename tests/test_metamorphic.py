@@ -42,10 +42,11 @@ import pytest
 import sympy
 from conftest import require_backend
 
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.render.run import render
 from implc.scene import View
-from implc.surface import Surface, load_surface
+from implc.surface import Surface
 from implc.symbols import X, Y, Z
 
 SIZE = 48

@@ -15,11 +15,11 @@ from cases import PAPER
 from conftest import require_gl
 
 from implc.emit import emit
+from implc.loaders import load_surface
 from implc.methods import CONSTANT_SYMBOLS, D0, F0, METHODS, TAYLOR2_CHOICES, X0, interval_test
 from implc.metrics import compare
 from implc.numeric import evaluate
 from implc.render.run import render
-from implc.surface import load_surface
 from implc.targets import get_target
 from implc.validate import validate_text
 

@@ -19,10 +19,10 @@ from implc.backends.opencl import OpenclPrinter
 from implc.cli import main
 from implc.emit import emit
 from implc.errors import ToolError
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import T_TOL
 from implc.render.run import render
-from implc.surface import load_surface
 from implc.symbols import X, Y, Z
 from implc.validate import validate_opencl, validate_text
 

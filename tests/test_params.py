@@ -25,10 +25,11 @@ from test_cli import implc
 from implc.emit import emit, param_uniforms
 from implc.errors import InputError
 from implc.front import param_symbol
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.render.run import open_runner, render
-from implc.surface import example_paths, load_surface
+from implc.surface import example_paths
 from implc.symbols import X, Y, Z
 
 WITH_PARAMS = [n for n in example_paths() if load_surface(n).params]

@@ -20,11 +20,11 @@ from cases import PAPER
 from conftest import require_gl
 
 from implc.derive import Derivatives
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.numeric import evaluate
 from implc.render.run import open_runner, render
 from implc.scene import pixel_rays
-from implc.surface import load_surface
 from implc.symbols import POINT
 
 SIZE = 96

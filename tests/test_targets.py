@@ -16,11 +16,12 @@ from implc.backends.printing import SPELLED
 from implc.emit import EMITS, emit
 from implc.errors import InputError, ToolError
 from implc.functions import BY_SYMPY_NAME, FUNCTIONS
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.render.run import BACKENDS, REFERENCE, backend_for, render
 from implc.resources import data_dir
-from implc.surface import Surface, load_surface
+from implc.surface import Surface
 from implc.symbols import X, Y, Z
 from implc.targets import TARGETS, resolve, target_of_file
 from implc.validate import validate_text

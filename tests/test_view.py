@@ -34,10 +34,10 @@ from browser_support import (
 from conftest import require_tool
 from test_cli import implc
 
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.render.run import render
 from implc.scene import SHADING, View
-from implc.surface import load_surface
 from implc.view import viewer_page
 
 SIZE = 256  # the first-frame comparison (the size)

@@ -17,10 +17,10 @@ from test_cli import implc
 from implc.backends.wgsl import RESERVED_WORDS, WgslPrinter
 from implc.emit import emit
 from implc.errors import ImplcError
+from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.render.run import render
-from implc.surface import load_surface
 from implc.symbols import X
 
 ROOT = Path(__file__).resolve().parent.parent
