@@ -66,11 +66,13 @@ test: lint
 golden: setup
 	$(PY) -m pytest tests/test_golden.py --update-golden
 
-# ruff, and node's parser over the viewer's script (templates/view/viewer.js, which
+# ruff; mypy --strict over the public API (implc/__init__.py, implc/api/); and node's parser over the viewer's script (templates/view/viewer.js, which
 # viewer.html.j2 includes), so a syntax error there fails here, not in a user's browser.
 JS_SOURCES := $(sort $(wildcard templates/*/*.js))
 lint: setup
 	$(PY) -m ruff check implc tests
+	$(PY) -m mypy --strict --follow-imports=silent --ignore-missing-imports --no-error-summary \
+	  implc/__init__.py implc/version.py implc/api
 	@for f in $(JS_SOURCES); do node --check $$f || exit 1; done
 
 # The paper's Table 1 into results/ (docs/RESULTS.md). 1024x1024 like the paper: on this

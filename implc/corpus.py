@@ -23,19 +23,18 @@ reported by `corpus_report.py`.
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import json
 import re
 import time
 import traceback
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
-from multiprocessing import get_context
 from pathlib import Path
 
 from .errors import ImplcError, InputError, ToolError
+from .executors import local_executor, stop_executor
 from .fileio import read_input
 from .targets import TARGETS as REGISTRY
 
@@ -183,13 +182,10 @@ def run_row(
     limits=None,
 ) -> RowResult:
     """Load, derive, check, emit and validate one row; never raises (bugs are results)."""
-    from .derive import derive_limits
-
     start = time.perf_counter()
     result = RowResult(row, targets={t: "-" for t in targets})
     try:
-        with derive_limits(limits.max_derived if limits is not None else None):
-            _run_row(result, targets, validate, check, limits)
+        _run_row(result, targets, validate, check, limits)
     except ToolError as err:
         result.tool_missing = str(err)
     except ImplcError as err:
@@ -214,7 +210,8 @@ def _run_row(result: RowResult, targets, validate: bool, check: bool, limits) ->
     from .validate import validate_text
 
     surface = row_surface(result.row, limits)
-    build_functions(surface.expr, get_method(METHOD))  # derive once; limits checked here
+    # derive once; limits checked here
+    build_functions(surface.expr, get_method(METHOD), surface.limits.max_derived)
     if check:
         result.numeric = numeric_check(surface.expr, seed=result.row.number)
         if not result.numeric.startswith("ok"):
@@ -339,8 +336,10 @@ def run_corpus(
     limits=None,
     progress: Callable[[RowResult], None] | None = None,
     targets_of: Callable[[Row], Sequence[str]] | None = None,
+    executor: Executor | None = None,
 ) -> list[RowResult]:
-    """`run_row` over every row, in `jobs` worker processes; results in row order.
+    """`run_row` over every row, on `executor` (e.g. a Dask cluster's) or else in `jobs`
+    local worker processes; results in row order.
 
     `targets_of(row)`, when given, chooses the targets row by row (e.g. a sample of rows
     on a slow validator) instead of `targets`.
@@ -351,17 +350,13 @@ def run_corpus(
         return tuple(targets_of(row) if targets_of else targets)
 
     results: list[RowResult] = []
-    if jobs <= 1 or len(rows) <= 1:
+    if executor is None and (jobs <= 1 or len(rows) <= 1):
         for row in rows:
             results.append(run_row(row, chosen(row), validate, check, limits))
             if progress:
                 progress(results[-1])
     else:
-        # spawn, not fork: wgpu, PoCL and the GL stack hold threads and handles. Workers
-        # ignore SIGINT (Ctrl-C reaches the whole process group): the parent alone
-        # decides, stops them and reports once.
-        pool = ProcessPoolExecutor(jobs, mp_context=get_context("spawn"),
-                                   initializer=_worker_signals)
+        pool = executor or local_executor(jobs)
         try:
             futures = [pool.submit(run_row, row, chosen(row), validate, check, limits)
                        for row in _costliest_first(rows)]
@@ -370,33 +365,15 @@ def run_corpus(
                 if progress:
                     progress(results[-1])
         except BaseException:
-            _stop_pool(pool)
+            stop_executor(pool)
             raise
-        pool.shutdown(wait=True)
+        if executor is None:
+            pool.shutdown(wait=True)
     results.sort(key=lambda r: r.row.number)
     missing = next((r.tool_missing for r in results if r.tool_missing), "")
     if missing:
         raise ToolError(missing)
     return results
-
-
-def _worker_signals() -> None:
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def _stop_pool(pool: ProcessPoolExecutor) -> None:
-    """Cancel what has not started and end the workers now (an interrupted run)."""
-    processes = list(getattr(pool, "_processes", {}).values())  # no public handle
-    pool.shutdown(wait=False, cancel_futures=True)
-    for process in processes:
-        with contextlib.suppress(Exception):
-            process.terminate()
-    for process in processes:
-        with contextlib.suppress(Exception):
-            process.join(5)
 
 
 def _costliest_first(rows: list[Row]) -> list[Row]:
@@ -409,17 +386,8 @@ def permissive(rows: Iterable[Row]) -> list[Row]:
     return [r for r in rows if r.licence in PERMISSIVE]
 
 
-def effective_jobs(jobs: int | None) -> int:
-    """`-j 0` (or none) means one worker per CPU, at most 4."""
-    import os
-
-    if jobs:
-        return max(1, jobs)
-    return max(1, min(4, os.cpu_count() or 1))
-
-
 __all__ = [
     "COMPILED", "FAILED", "REJECTED", "TARGETS", "Row", "RowResult", "default_tsv",
-    "effective_jobs", "load_rows", "numeric_check", "permissive", "row_surface", "run_corpus",
+    "load_rows", "numeric_check", "permissive", "row_surface", "run_corpus",
     "run_row",
 ]

@@ -10,9 +10,6 @@ supplies the same named quantities; methods only name what they need.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
 from functools import cached_property, lru_cache
 
 import sympy
@@ -26,28 +23,8 @@ from .symbols import DIRECTION, POINT
 # quantity a marcher may ask for (S, the gradient, F', F'' and the Laplacian) before CSE.
 # sympy's differentiation and `cse` take time roughly proportional to it (about 20-50 us
 # a node here); the largest corpus row (a degree-18 torus knot) estimates ~340,000.
-DEFAULT_MAX_DERIVED = Limits().max_derived
-_MAX_DERIVED: ContextVar[int] = ContextVar("implc_max_derived", default=DEFAULT_MAX_DERIVED)
+DEFAULT_MAX_DERIVED = Limits().max_derived  # a surface's own is `Surface.limits`
 _CAP = 10**15  # estimates saturate here, so hostile input cannot build huge integers
-
-
-@contextmanager
-def derive_limits(max_derived: int | None) -> Iterator[None]:
-    """Set the derived-size bound for everything derived inside the block (the CLI's
-    `--max-derived`); None keeps the current one."""
-    if max_derived is None:
-        yield
-        return
-    token = _MAX_DERIVED.set(max_derived)
-    try:
-        yield
-    finally:
-        _MAX_DERIVED.reset(token)
-
-
-def current_max_derived() -> int:
-    """The bound `Derivatives` checks against (part of emit's cache key)."""
-    return _MAX_DERIVED.get()
 
 
 def estimate_derived_size(expr: sympy.Expr) -> int:
@@ -97,13 +74,13 @@ def _node_estimate(node, parts: list[tuple[int, int, int]], point) -> tuple[int,
     return s, min(_CAP, d1), min(_CAP, d2)
 
 
-def check_derived_size(expr: sympy.Expr, max_derived: int | None = None) -> int:
+def check_derived_size(expr: sympy.Expr, max_derived: int = DEFAULT_MAX_DERIVED) -> int:
     """Raise `LimitError` ("too complex: ...") when `expr`'s derivatives would be too big.
 
     Returns the estimate. Runs before any differentiation, so a compile that would run
     for minutes (or exhaust memory or Python's recursion limit inside sympy) stops at once.
     """
-    limit = current_max_derived() if max_derived is None else max_derived
+    limit = max_derived
     size = estimate_derived_size(expr)
     if size > limit:
         raise LimitError(
@@ -133,7 +110,7 @@ QUANTITIES = {
 class Derivatives:
     """All derived quantities of one surface function, each computed at most once."""
 
-    def __init__(self, expr: sympy.Expr, max_derived: int | None = None):
+    def __init__(self, expr: sympy.Expr, max_derived: int = DEFAULT_MAX_DERIVED):
         check_derived_size(expr, max_derived)
         self.expr = expr
 

@@ -18,8 +18,8 @@ from functools import cache
 import jinja2
 import sympy
 
-from .derive import current_max_derived
-from .errors import InputError
+from .derive import DEFAULT_MAX_DERIVED
+from .errors import InputError, OptionError
 from .front import param_symbol
 from .marcher import choose_form, lower, point_sets
 from .methods import Constants, Method, get_method
@@ -28,7 +28,7 @@ from .pieces import build_programs, function_name
 from .resources import data_dir
 from .scene import SHADING, View, light_directions, shading_for
 from .surface import Surface
-from .targets import flavor_problem, get_target, prefix_problem
+from .targets import TARGETS, flavor_problem, get_target, prefix_problem
 
 EMITS = ("program", "library")
 PARAM_MODES = ("constant", "uniform")
@@ -94,15 +94,65 @@ def function_quantities(method: Method) -> dict[str, tuple[str, ...]]:
     return {function_name(q): q for q in point_sets(method)}
 
 
-def build_functions(expr: sympy.Expr, method: Method) -> dict[str, Program]:
+def build_functions(expr: sympy.Expr, method: Method,
+                    max_derived: int = DEFAULT_MAX_DERIVED) -> dict[str, Program]:
     """Derive and optimize every point function the method needs in the point form
     (jointly CSE'd per function).
 
     Raises `LimitError` first when the derivatives would exceed `--max-derived`."""
-    return build_programs(expr, point_sets(method), current_max_derived())
+    return build_programs(expr, point_sets(method), max_derived)
 
 
-def emit(
+@dataclass(frozen=True)
+class CompiledShader:
+    """What one compile decided, so that nothing above emit decides it again: the text
+    and the form it was emitted in (a runner reads its uniforms, a sidecar its evaluation
+    form). `warnings` and `notes` are filled by the caller that knows them (the API's
+    float32 report, the framing)."""
+
+    text: str
+    target: str
+    method: str
+    form: str  # the evaluation form used: "point" or "ray-poly" (never "auto")
+    emit: str  # "program" or "library"
+    flavor: str
+    precision: str
+    prefix: str
+    params: str  # "constant" or "uniform"
+    uniforms: tuple[ParamUniform, ...]  # empty unless params == "uniform"
+    constants: Constants
+    warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
+
+
+def check_shader_options(target: str, flavor: str | None = None,
+                         precision: str | None = None, prefix: str = "",
+                         emit_form: str = "program", params: str = "constant") -> None:
+    """Raise OptionError where a flavour, precision, prefix, emit form or parameter mode
+    does not fit the target (the one place they are checked; the command line calls it
+    before any work so that a bad option is reported first)."""
+    tgt = get_target(target)
+    if flavor is not None and (problem := flavor_problem(tgt, flavor, precision or "float")):
+        raise OptionError(f"--flavor: {problem}")
+    if precision is not None and precision not in tgt.precisions:
+        others = [t.name for t in TARGETS.values() if precision in t.precisions]
+        raise OptionError(f"--precision {precision}: {tgt.name} has "
+                          f"{' or '.join(tgt.precisions)} only ({precision}: "
+                          f"{', '.join(others)})")
+    if problem := prefix_problem(prefix, tgt):
+        raise OptionError(problem)
+    if emit_form not in EMITS:
+        raise OptionError(f"unknown emit '{emit_form}'; choose from {', '.join(EMITS)}")
+    if params not in PARAM_MODES:
+        raise OptionError(f"unknown --params '{params}'; choose from "
+                          f"{', '.join(PARAM_MODES)}")
+    if params == "uniform" and tgt.flavors[flavor or tgt.default_flavor].get("shadertoy"):
+        # an input error (exit 1), as it has always been: the surface's parameters
+        raise InputError("the shadertoy flavour has no uniforms of its own: use "
+                         "--params constant (the default) with --flavor shadertoy")
+
+
+def compile_shader(
     surface: Surface,
     target: str = "glsl",
     method: str = "hessian",
@@ -113,29 +163,19 @@ def emit(
     precision: str | None = None,
     evaluation: str | None = None,
     params: str = "constant",
-) -> str:
-    """The complete shader text for `surface` (deterministic, byte for byte).
+) -> CompiledShader:
+    """The shader for `surface` (its text deterministic, byte for byte) and what was
+    decided on the way.
 
     `params`: "constant" bakes the parameters' values into the expressions; "uniform"
     keeps them as uniforms the host sets at run time (`param_uniforms`)."""
+    check_shader_options(target, flavor, precision, prefix, emit_form, params)
     tgt = get_target(target)
     meth = get_method(method)
     constants = constants or meth.defaults
     flavor = flavor or tgt.default_flavor
     precision = precision or "float"
-    if precision not in tgt.precisions:
-        raise InputError(f"target {target} supports precision {', '.join(tgt.precisions)}")
-    problem = flavor_problem(tgt, flavor, precision) or prefix_problem(prefix, tgt)
-    if problem:
-        raise InputError(problem)
-    if emit_form not in EMITS:
-        raise InputError(f"unknown emit '{emit_form}'; choose from {', '.join(EMITS)}")
-    if params not in PARAM_MODES:
-        raise InputError(f"unknown --params '{params}'; choose from {', '.join(PARAM_MODES)}")
     uniforms = param_uniforms(surface, target, emit_form, prefix) if params == "uniform" else []
-    if uniforms and tgt.flavors[flavor].get("shadertoy"):
-        raise InputError("the shadertoy flavour has no uniforms of its own: use "
-                         "--params constant (the default) with --flavor shadertoy")
     printer = tgt.make_printer(precision)
     expr, equation = surface.expr, surface.equation
     if uniforms:  # the parameters as symbols named as the shader reads them
@@ -143,10 +183,10 @@ def emit(
             {param_symbol(u.name): sympy.Symbol(u.ref, real=True) for u in uniforms})
         equation = surface.symbolic_equation
     # the same form as with --params constant
-    form = choose_form(meth, surface.expr, evaluation or constants.evaluation)
+    max_derived = surface.limits.max_derived
+    form = choose_form(meth, surface.expr, evaluation or constants.evaluation, max_derived)
     carried = (("Params", "params"),) if uniforms and tgt.params_read_as == "argument" else ()
-    marcher = lower(meth, constants, expr, form, printer, prefix, current_max_derived(),
-                    carried)
+    marcher = lower(meth, constants, expr, form, printer, prefix, max_derived, carried)
     label = meth.name + (f" (Eq. 4: {constants.taylor2})" if meth.reads_taylor2 else "")
     types = _types(tgt, precision, prefix)
     literals = {"zero": 0.0, "half": 0.5, "one": 1.0, "four": 4.0}
@@ -178,7 +218,26 @@ def emit(
         "view": _print_view(surface.view, shade_printer),
     }
     template = environment(tgt.name).get_template(tgt.templates[emit_form])
-    return template.render(context)
+    return CompiledShader(template.render(context), tgt.name, meth.name, marcher.form,
+                          emit_form, flavor, precision, prefix, params, tuple(uniforms),
+                          constants)
+
+
+def emit(
+    surface: Surface,
+    target: str = "glsl",
+    method: str = "hessian",
+    constants: Constants | None = None,
+    flavor: str | None = None,
+    emit_form: str = "program",
+    prefix: str = "",
+    precision: str | None = None,
+    evaluation: str | None = None,
+    params: str = "constant",
+) -> str:
+    """The shader text alone (`compile_shader(...).text`), for callers that need no more."""
+    return compile_shader(surface, target, method, constants, flavor, emit_form, prefix,
+                          precision, evaluation, params).text
 
 
 def _struct_size(offset: int | None, count: int) -> int:

@@ -106,6 +106,19 @@ class InputError(ImplcError):
                 f"{tail}")
 
 
+class OptionError(ImplcError):
+    """An option that does not fit: a choice a target does not have, contradicting
+    options, a view that shows nothing (exit 2 on the command line, which names its
+    flag; a keyword argument of the Python API). Distinct from InputError, which is
+    about what the user wrote as a surface."""
+
+    exit_code = EXIT_USAGE
+
+    def __init__(self, message: str):
+        super().__init__(message)
+        self.message = message
+
+
 class OutputError(InputError):
     """An output that cannot be written: a missing or read-only directory, an unknown
     extension, a directory where a file should go, a full disk (exit code 1)."""

@@ -34,7 +34,7 @@ from functools import lru_cache
 import sympy
 from sympy import Abs, Max, Min, Piecewise
 
-from .derive import Derivatives
+from .derive import DEFAULT_MAX_DERIVED, Derivatives
 from .errors import InputError
 from .functions import BIG, BY_SYMPY_NAME
 from .pieces import ShaderFunction, sym
@@ -250,7 +250,8 @@ class _Builder:
         return self.widened(lo, hi, ulps, absolute)
 
 
-def derivative_program(expr: sympy.Expr, max_derived: int | None = None) -> RangeProgram | None:
+def derivative_program(expr: sympy.Expr,
+                       max_derived: int = DEFAULT_MAX_DERIVED) -> RangeProgram | None:
     """F and F' = grad S . d enclosed jointly over a segment, or None where F may jump
     (sign's derivative is a delta, which has no interval rule): the march's monotonic test
     then does not apply. F' is derived under `--max-derived` (default: the current one)."""

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import sympy
 
-from .derive import current_max_derived, polynomial_degree
+from .derive import DEFAULT_MAX_DERIVED, polynomial_degree
 from .errors import InputError
 from .interval import (
     check_interval,
@@ -98,7 +98,8 @@ _MARCH_POINT = "(ray.o + s0*ray.d) + h*ray.d"  # values_at's point: s = s0 + h
 REFINE_SET = ("S", "dS")
 
 
-def choose_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> str:
+def choose_form(method: Method, expr: sympy.Expr, requested: str = "auto",
+                max_derived: int = DEFAULT_MAX_DERIVED) -> str:
     """The evaluation form `method`'s shader for `expr` uses when `requested` is asked (as
     `lower` prints it; what a render's sidecar records): the exact solver works on the ray
     polynomial, the interval method at points. A marcher takes what is asked, and under
@@ -120,18 +121,20 @@ def choose_form(method: Method, expr: sympy.Expr, requested: str = "auto") -> st
         return requested
     if degree > AUTO_RAY_POLY_MAX_DEGREE:
         return "point"
-    cheaper = step_ops(method, expr, "ray-poly") < step_ops(method, expr, "point")
+    cheaper = (step_ops(method, expr, "ray-poly", max_derived)
+               < step_ops(method, expr, "point", max_derived))
     return "ray-poly" if cheaper else "point"
 
 
-def step_ops(method: Method, expr: sympy.Expr, form: str) -> int:
+def step_ops(method: Method, expr: sympy.Expr, form: str,
+             max_derived: int = DEFAULT_MAX_DERIVED) -> int:
     """Operations a march step of `method` evaluates in `form` (`--eval auto`'s measure,
     `implc show` prints it): its point functions after optimization, plus Estrin's sums
     for the ray derivatives. The ray coefficients, once a ray, are left out: counted
     over taylor's steps (about 30 a pixel at 512^2 on the sweep's surfaces), they would
     give Chmutov's surfaces the point form, which measured 2-9 % slower there."""
     degree = polynomial_degree(expr)
-    programs = build_programs(expr, point_sets(method, form), current_max_derived())
+    programs = build_programs(expr, point_sets(method, form), max_derived)
     calls = [call for quantities in _sample_groups(method).values()
              for call in _split(quantities, form)]
     return sum(programs[function_name(qs)].ops_after if kind == "point" else

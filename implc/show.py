@@ -2,22 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import sympy
 
-from .conditioning import (
-    RAY_WARN_SHARE,
-    WARN_SHARE,
-    Conditioning,
-    float32_conditioning,
-    ray_conditioning,
-)
-from .derive import Derivatives, current_max_derived, polynomial_degree
+from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
+from .float32 import float32_report
 from .marcher import choose_form, evaluations, step_ops
 from .methods import Constants, Method
-from .options import AUTO_RAY_POLY_MAX_DEGREE, EXACT_MAX_DEGREE, T_TOL
+from .options import AUTO_RAY_POLY_MAX_DEGREE, T_TOL
 from .pieces import build_programs
 from .raypoly import (
     HORNER_ABOVE,
@@ -26,63 +18,14 @@ from .raypoly import (
     estrin_derivative_ops,
     ray_quantity_ops,
 )
-from .scene import View
 from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, walk_cost
 from .surface import Surface
-from .symbols import POINT
 from .targets import where_precision
 from .textform import to_text, value_text
 
 
-@dataclass(frozen=True)
-class Float32Report:
-    """Both measures of a polynomial surface, each None where it does not apply."""
-
-    point: Conditioning | None  # S at sampled points of the surface: every method
-    ray: Conditioning | None  # exact's ray coefficients on the view's pixel rays
-
-    @property
-    def point_warns(self) -> bool:
-        return self.point is not None and self.point.far >= WARN_SHARE
-
-    @property
-    def ray_warns(self) -> bool:
-        return self.ray is not None and self.ray.far >= RAY_WARN_SHARE
-
-    def warning(self, method: str) -> str | None:
-        """What float32 does to `method`'s picture where a measure says it is too far
-        (None where none does): for exact its own coefficients' share, which follows its
-        share of wrong pixels, else S's: the line `compile`, `render` and `view` print
-        (`implc show` prints both measures in full)."""
-        if method == "exact" and self.ray_warns:
-            return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
-                    f"moves the first root by more than {T_TOL:g} on "
-                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (expect about "
-                    "that share of wrong pixels)")
-        if self.point_warns:
-            return (f"float32 cannot hold this surface: a rounding of S moves it by more "
-                    f"than {T_TOL:g} at {100 * self.point.far:.1f} % of its sampled points "
-                    "(expect wrong pixels from every method)")
-        return None
-
-
-def float32_report(expr: sympy.Expr, view: View, degree: int,
-                   gradient: tuple[sympy.Expr, ...] | None = None,
-                   point: bool = True) -> Float32Report:
-    """The ray coefficients' measure where exact's Newton reads F from them (degree
-    ROBUST_NEWTON_BELOW to EXACT_MAX_DEGREE), and S's at any degree unless `point` is
-    False (0.04-0.3 s: what a warning for exact alone does not need)."""
-    ray = (ray_conditioning(coefficient_program(expr, "float"), view)
-           if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
-    if not point:
-        return Float32Report(None, ray)
-    if gradient is None:
-        gradient = tuple(sympy.diff(expr, v) for v in POINT)
-    return Float32Report(float32_conditioning(expr, gradient), ray)
-
-
 def describe(surface: Surface, method: Method) -> str:
-    d = Derivatives(surface.expr)
+    d = Derivatives(surface.expr, surface.limits.max_derived)
     degree = polynomial_degree(surface.expr)
     equation, *substituted = surface.equation_lines()
     lines = [
@@ -110,7 +53,8 @@ def describe(surface: Surface, method: Method) -> str:
         "optimization):",
     ]
     total_before = total_after = 0
-    for name, program in build_functions(surface.expr, method).items():
+    for name, program in build_functions(surface.expr, method,
+                                         surface.limits.max_derived).items():
         quantities = ", ".join(function_quantities(method)[name])
         lines.append(
             f"  {name:<5} ({quantities}): {program.ops_before:>6} -> {program.ops_after:<6}"
@@ -159,7 +103,7 @@ def _interval_lines(surface: Surface) -> list[str]:
     """What one node of the interval walk evaluates (templates/interval.j2)."""
     from .interval import derivative_program, range_program
 
-    joint = derivative_program(surface.expr)
+    joint = derivative_program(surface.expr, surface.limits.max_derived)
     program = joint or range_program(surface.expr)
     what = "F and F'" if joint else "F (no monotonic test: F' has no interval rule)"
     return ["", f"interval: per node, the enclosure of {what} over the segment: "
@@ -186,7 +130,8 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
             *([f"  in double (--precision double): {double} ops (one Horner's rule a "
                "coefficient, in o^2 where its powers share a parity)"]
               if double != coefficients.ops_after else []),
-            *_solver_lines(surface.expr, degree, coefficients.ops_after),
+            *_solver_lines(surface.expr, degree, coefficients.ops_after,
+                           surface.limits.max_derived),
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
@@ -194,11 +139,13 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
                          for q in dict.fromkeys(quantities))
     point = [" + ".join(qs) for kind, qs in evaluations(method, "ray-poly")
              if kind == "point" and qs not in (("S",), ("grad",))]
-    costs = {form: step_ops(method, surface.expr, form) for form in ("point", "ray-poly")}
+    limit = surface.limits.max_derived
+    costs = {form: step_ops(method, surface.expr, form, limit) for form in ("point", "ray-poly")}
+    auto = choose_form(method, surface.expr, "auto", limit)
     return [
         "",
         f"per march step: point form {costs['point']} ops, ray-poly form "
-        f"{costs['ray-poly']} ops; --eval auto takes {choose_form(method, surface.expr)}"
+        f"{costs['ray-poly']} ops; --eval auto takes {auto}"
         + (f" (ray-poly only up to degree {AUTO_RAY_POLY_MAX_DEGREE}, where it measured as "
            "accurate)" if degree > AUTO_RAY_POLY_MAX_DEGREE else ""),
         "ray-poly form:",
@@ -221,10 +168,11 @@ def _short(expr: sympy.Expr, limit: int = 200) -> str:
     return text if len(text) <= limit else text[:limit] + " ..."
 
 
-def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int) -> list[str]:
+def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int,
+                  max_derived: int) -> list[str]:
     """The exact solver's strategy at this degree, its work per node or level, and (for
     the Bernstein walk) the operations a ray costs."""
-    s_ops = build_programs(expr, (("S",),), current_max_derived())["S"].ops_after
+    s_ops = build_programs(expr, (("S",),), max_derived)["S"].ops_after
     if degree < BERNSTEIN_FROM:
         # F (P_n): Estrin's value and S at the point, both computed; a Newton or Halley
         # iteration reads F, F' and F''

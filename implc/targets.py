@@ -33,8 +33,9 @@ def resolve(reference: str) -> Callable:
 class Backend:
     """A render backend: the runner of one target's program at one precision.
 
-    A precision is a backend of its own (`cl`, `cl-double`) so that every runner factory
-    has the same signature: (surface, method, constants, width, height) -> Runner.
+    A precision is a backend of its own (`cl`, `cl-double`); every runner factory has
+    the same signature: (CompiledShader, View, width, height) -> Runner, the shader being
+    its target's default flavour at the backend's precision (render/run.py).
     """
 
     runner: str  # "module:function", the runner factory
@@ -135,7 +136,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         backends={"gl": Backend("implc.render.gl:open_gl_runner",
                                 "GLSL 330 on OpenGL (moderngl, EGL; llvmpipe here)",
                                 probe="implc.render.gl:context"),
-                  "gl-double": Backend("implc.render.gl:open_gl_double_runner",
+                  "gl-double": Backend("implc.render.gl:open_gl_runner",
                                        "the same with the surface solved in double "
                                        "(needs GL_ARB_gpu_shader_fp64)",
                                        precision="double",
@@ -180,7 +181,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
             "cl": Backend("implc.render.cl_runner:open_cl_runner",
                           "OpenCL C kernel, float (pyopencl; PoCL here)",
                           probe="implc.devices:opencl_device"),
-            "cl-double": Backend("implc.render.cl_runner:open_cl_double_runner",
+            "cl-double": Backend("implc.render.cl_runner:open_cl_runner",
                                  "the same in double precision (needs cl_khr_fp64)",
                                  precision="double", probe="implc.devices:opencl_device"),
         },

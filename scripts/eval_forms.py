@@ -107,7 +107,7 @@ def float32_holds(surface) -> bool:
     implc/conditioning.py) does not fire. Where it fires no method's float32 picture is
     right (Chmutov from degree 16: 52 % of the points at 18, 66 % at 20), so the sweep
     solves both methods in double there, as the warning advises."""
-    from implc.show import float32_report
+    from implc.float32 import float32_report
 
     degree = polynomial_degree(surface.expr)
     if degree is None:

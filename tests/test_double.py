@@ -10,7 +10,7 @@ from conftest import require_backend, require_validator
 
 from implc.backends.glsl import GlslPrinter
 from implc.emit import emit
-from implc.errors import InputError
+from implc.errors import InputError, OptionError
 from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
@@ -59,7 +59,7 @@ def test_double_validates_in_both_desktop_flavours(flavor, kind):
 
 @pytest.mark.parametrize("flavor", ["es300", "shadertoy"])
 def test_double_is_refused_where_glsl_has_none(flavor):
-    with pytest.raises(InputError, match=f"the glsl flavour {flavor} has no double precision: "
+    with pytest.raises(OptionError, match=f"the glsl flavour {flavor} has no double precision: "
                                          "use --precision double with 330 or 450"):
         emit(load_surface("cross-cap"), "glsl", "exact", flavor=flavor, precision="double")
 

@@ -323,17 +323,16 @@ def check_path(expr: sympy.Expr, rng: random.Random, keep: float = 0.25) -> None
     """Property 2 (and a sample for property 3) on a parsed expression: the whole path
     to every target's printer; each shader is kept for
     validation with probability `keep`."""
-    from implc.derive import derive_limits
     from implc.emit import emit
+    from implc.limits import Limits
     from implc.surface import Surface
 
     STATS["path"] += 1
-    surface = Surface("fuzz", expr)
+    surface = Surface("fuzz", expr, limits=Limits(max_derived=PATH_MAX_DERIVED))
     method = rng.choice(["hessian", "taylor", "curvature"])
     texts = {}
     try:
-        with (bounded(PATH_SECONDS, "path", f"compiling {expr}"),
-              derive_limits(PATH_MAX_DERIVED)):
+        with bounded(PATH_SECONDS, "path", f"compiling {expr}"):
             for target in TARGET_NAMES:
                 texts[target] = emit(surface, target, method)
     except ImplcError as err:

@@ -345,7 +345,6 @@ def test_max_derived_is_configurable(tmp_path):
 def test_over_large_valid_inputs_stop_before_differentiating(equation, monkeypatch):
     """Shapes that pass the parser but would run for minutes, recurse past Python's
     limit inside sympy, or exhaust memory: each stops at once with the derived bound."""
-    from implc.derive import derive_limits
     from implc.emit import emit
     from implc.errors import LimitError
     from implc.loaders import load_surface
@@ -354,7 +353,8 @@ def test_over_large_valid_inputs_stop_before_differentiating(equation, monkeypat
     derived = []  # the bound on work: sympy differentiates nothing before the refusal
     real_diff = sympy.diff
     monkeypatch.setattr(sympy, "diff", lambda *a, **k: derived.append(a) or real_diff(*a, **k))
-    with derive_limits(500_000), pytest.raises(LimitError, match=r"\(--max-derived\)$"):
+    assert surface.limits.max_derived == 500_000  # the default bound, carried by the surface
+    with pytest.raises(LimitError, match=r"\(--max-derived\)$"):
         emit(surface, "glsl", "hessian")
     assert derived == []
 

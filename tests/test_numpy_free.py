@@ -82,6 +82,11 @@ def digests() -> dict[str, str]:
         except ImplcError as err:  # a refused combination: its message
             text = f"{type(err).__name__}: {err}"
         result["|".join(case)] = hashlib.sha256(text.encode()).hexdigest()
+    import implc  # the public API's compile, on examples whose files set their view
+
+    for name, target in itertools.product(("cross-cap", "torus"), ("glsl", "wgsl", "hlsl")):
+        shader = implc.Surface.example(name).compile(target, params="uniform")
+        result[f"api|{name}|{target}"] = hashlib.sha256(shader.text.encode()).hexdigest()
     return result
 
 

@@ -23,7 +23,7 @@ from conftest import require_backend, require_gl
 from test_cli import implc
 
 from implc.emit import emit, param_uniforms
-from implc.errors import InputError
+from implc.errors import InputError, OptionError
 from implc.front import param_symbol
 from implc.loaders import load_surface
 from implc.methods import METHODS
@@ -117,7 +117,7 @@ def test_uniform_refusals():
     surface = load_surface("torus")
     with pytest.raises(InputError, match="shadertoy"):
         emit(surface, "glsl", flavor="shadertoy", params="uniform")
-    with pytest.raises(InputError, match="--params"):
+    with pytest.raises(OptionError, match="--params"):
         emit(surface, params="baked")
     odd = load_surface(equation="x^2 + y^2 + z^2 - a__b", params=["a__b=1"])
     with pytest.raises(InputError, match="reserved"):

@@ -63,7 +63,7 @@ def test_validator_and_runners_resolve_with_their_signatures(name):
     assert target.backends, f"{name} has no render backend"
     for backend in target.backends.values():
         inspect.signature(resolve(backend.runner)).bind(
-            "surface", "method", "constants", "width", "height")
+            "shader", "view", "width", "height")
         inspect.signature(resolve(backend.probe)).bind()  # tests open the runtime with it
 
 

@@ -12,6 +12,7 @@ import statistics
 import sys
 import time
 from collections.abc import Mapping, Sequence
+from concurrent.futures import Executor
 from pathlib import Path
 from typing import TextIO
 
@@ -105,6 +106,7 @@ def run_bench(
     exr: bool = False,
     baseline: bool = False,
     progress: TextIO | None = sys.stderr,
+    executor: Executor | None = None,
 ) -> BenchRun:
     """Measure every configuration x surface x method and write the outputs to `out_dir`.
 
@@ -112,6 +114,8 @@ def run_bench(
     With `baseline`, the hand-written programs of implc/baseline.py (GL only) are timed
     in the same rounds as the generated ones.
     Progress goes to `progress`: a bar with an ETA on a terminal, numbered lines otherwise.
+    The references are computed on `executor` when one is given (the frames are always
+    timed here, alone).
     """
     _check_args(surfaces, size, methods, frames, backend, equal_step)
     bench_configs = make_configs(configs, equal_step)
@@ -120,14 +124,23 @@ def run_bench(
     # error, Ctrl-C or SIGTERM midway leaves no partial run behind (implc.fileio)
     with staged_directory(out_dir) as stage:
         run = _measure(surfaces, stage, size, methods, frames, backend, bench_configs, exr,
-                       progress, baseline)
+                       progress, baseline, executor)
         write_outputs(run, stage)
     _printer(progress)(f"wrote {out_dir / 'table.md'}, table.json, figure.png, renders/")
     return run
 
 
+def reference_frame(surface: Surface, size: int) -> tuple[RenderResult, float]:
+    """The exact CPU reference of `surface` at `size`² and the seconds it took (a plain
+    function of plain values, so an executor's worker can run it)."""
+    start = time.perf_counter()
+    unused = METHODS["taylor"].defaults  # the reference has no method constants
+    ref = open_runner(surface, "reference", "", unused, size, size).frame()
+    return ref, time.perf_counter() - start
+
+
 def _measure(surfaces, out_dir: Path, size, methods, frames, backend, bench_configs, exr,
-             progress, baseline: bool = False) -> BenchRun:
+             progress, baseline: bool = False, executor: Executor | None = None) -> BenchRun:
     from ..figure import tile_image
     from ..render.image_io import write_render
 
@@ -142,14 +155,16 @@ def _measure(surfaces, out_dir: Path, size, methods, frames, backend, bench_conf
              f"warm-up, backend {backend} ({run.machine.get('gl_renderer', '?')})")
     try:
         references: dict[str, RenderResult] = {}
+        # every reference is computed (on the executor, if any) before any frame is timed
+        pending = ({key: executor.submit(reference_frame, surface, size)
+                    for key, surface in surfaces.items()} if executor is not None else {})
         for key, surface in surfaces.items():
-            start = time.perf_counter()
-            unused = METHODS["taylor"].defaults  # the reference has no method constants
-            ref = open_runner(surface, "reference", "", unused, size, size).frame()
-            run.reference_seconds[key] = time.perf_counter() - start
+            ref, seconds = (pending[key].result() if pending
+                            else reference_frame(surface, size))
+            run.reference_seconds[key] = seconds
             references[key] = ref
             name = f"{key}-reference.png"
-            write_render(ref, renders / name, metadata(surface, "reference", "", unused, ref))
+            write_render(ref, renders / name, metadata(surface, "reference", None, ref))
             run.tiles["reference", key, "reference"] = tile_image(ref.color, TILE)
             bar.note(f"reference {key}: {run.reference_seconds[key]:.2f} s")
         for config in bench_configs:
@@ -183,6 +198,7 @@ def _measure_surface(run, config, chosen, key, surface, reference, renders, exr,
             runners.append(open_baseline_runner(key, method, constants[chosen.index(method)],
                                                 surface, size, size))
         seconds, results, compiled = time_interleaved(runners, run.frames)
+        shaders = [runner.shader for runner in runners[:len(chosen)]]
     finally:
         for runner in runners:
             runner.release()
@@ -190,7 +206,7 @@ def _measure_surface(run, config, chosen, key, surface, reference, renders, exr,
         result = results[index]
         fps = statistics.median(1.0 / max(s, 1e-9) for s in seconds[index])
         stem = f"{key}-{method}-{config.name}"
-        meta = metadata(surface, backend, method, constants[index], result)
+        meta = metadata(surface, backend, shaders[index], result)
         write_render(result, renders / f"{stem}.png", meta)
         if exr:
             write_render(result, renders / f"{stem}.exr", meta)

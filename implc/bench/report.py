@@ -9,10 +9,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .. import __version__
 from ..fileio import write_atomic, write_with
 from ..methods import METHODS
 from ..metrics import T_TOL
+from ..version import __version__
 from .records import BenchConfig, BenchRun, Cell
 
 # The paper's Table 1 (NVidia Quadro P5000, 1024x1024): fps and SSIM as printed. The

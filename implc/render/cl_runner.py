@@ -17,11 +17,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ..devices import FP64, import_pyopencl, opencl_build, opencl_device
-from ..emit import ParamUniform, emit, param_uniforms
+from ..emit import CompiledShader, ParamUniform
 from ..errors import ToolError
-from ..methods import Constants
 from ..scene import View
-from ..surface import Surface
 from .result import RenderResult, TimedRunner
 
 
@@ -95,15 +93,7 @@ class ClRunner(TimedRunner):
         self.aux.release()
 
 
-def open_cl_runner(surface: Surface, method: str, constants: Constants, width: int,
-                   height: int, precision: str = "float", params: str = "constant") -> ClRunner:
-    """Runner factory of backend `cl` (float) and, with precision="double", `cl-double`
-    (params="uniform": the parameters are kernel arguments, moved by `set_params`)."""
-    source = emit(surface, "opencl", method, constants, precision=precision, params=params)
-    uniforms = param_uniforms(surface, "opencl") if params == "uniform" else ()
-    return ClRunner(source, surface.view, width, height, precision, uniforms)
-
-
-def open_cl_double_runner(surface: Surface, method: str, constants: Constants, width: int,
-                          height: int, params: str = "constant") -> ClRunner:
-    return open_cl_runner(surface, method, constants, width, height, "double", params)
+def open_cl_runner(shader: CompiledShader, view: View, width: int, height: int) -> ClRunner:
+    """Runner factory of backends `cl` (float) and `cl-double` (a `--params uniform`
+    shader's parameters are kernel arguments, moved by `set_params`)."""
+    return ClRunner(shader.text, view, width, height, shader.precision, shader.uniforms)

@@ -12,12 +12,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..emit import ParamUniform, emit, param_uniforms, render_template
+from ..emit import CompiledShader, ParamUniform, render_template
 from ..errors import ToolError
 from ..interrupts import signals_held
-from ..methods import Constants
 from ..scene import View
-from ..surface import Surface
 from .result import RenderResult, TimedRunner
 
 TRIANGLES = 0x0004  # GL_TRIANGLES
@@ -121,18 +119,9 @@ class GlRunner(TimedRunner):
             obj.release()
 
 
-def open_gl_runner(surface: Surface, method: str, constants: Constants, width: int,
-                   height: int, params: str = "constant", precision: str = "float") -> GlRunner:
-    """Runner factory of backend `gl` and, with precision="double", `gl-double`: the 330
-    core program over a full-screen triangle (params="uniform": the parameters are
-    uniforms, moved by `set_params`)."""
-    fragment = emit(surface, "glsl", method, constants, flavor="330", params=params,
-                    precision=precision)
+def open_gl_runner(shader: CompiledShader, view: View, width: int, height: int) -> GlRunner:
+    """Runner factory of backends `gl` and `gl-double`: the 330 core program over a
+    full-screen triangle (a `--params uniform` shader's parameters are uniforms, moved by
+    `set_params`)."""
     vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
-    uniforms = param_uniforms(surface, "glsl") if params == "uniform" else ()
-    return GlRunner(fragment, vertex, surface.view, width, height, uniforms)
-
-
-def open_gl_double_runner(surface: Surface, method: str, constants: Constants, width: int,
-                          height: int, params: str = "constant") -> GlRunner:
-    return open_gl_runner(surface, method, constants, width, height, params, "double")
+    return GlRunner(shader.text, vertex, view, width, height, shader.uniforms)

@@ -23,10 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..emit import emit, param_uniforms, render_template
+from ..emit import CompiledShader, render_template
 from ..errors import ToolError
-from ..methods import Constants
-from ..surface import Surface
+from ..scene import View
 from .gl import GlRunner, context
 from .result import RenderResult
 
@@ -88,11 +87,10 @@ class HlslRunner(GlRunner):
         return RenderResult.from_buffers(color.reshape(shape), aux.reshape(shape))
 
 
-def open_hlsl_runner(surface: Surface, method: str, constants: Constants, width: int,
-                     height: int, params: str = "constant") -> HlslRunner:
-    """Runner factory of backend `hlsl-spirv` (params="uniform": the parameters are
-    uniforms, moved by `set_params`)."""
-    fragment = hlsl_to_glsl(emit(surface, "hlsl", method, constants, params=params))
+def open_hlsl_runner(shader: CompiledShader, view: View, width: int,
+                     height: int) -> HlslRunner:
+    """Runner factory of backend `hlsl-spirv` (a `--params uniform` shader's parameters
+    are uniforms, moved by `set_params`)."""
+    fragment = hlsl_to_glsl(shader.text)
     vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
-    uniforms = param_uniforms(surface, "hlsl") if params == "uniform" else ()
-    return HlslRunner(fragment, vertex, surface.view, width, height, uniforms)
+    return HlslRunner(fragment, vertex, view, width, height, shader.uniforms)

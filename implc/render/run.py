@@ -1,6 +1,7 @@
-"""Render a surface with a backend and write the outputs: the one entry point for `render`
-and `bench`. A backend is a runner factory: `open_runner(...)` returns an object with
-`frame() -> RenderResult` (render once, wait for completion, read back) and `release()`.
+"""Render a surface with a backend: the one entry point for the API's `render` and for
+`bench`. A backend is a runner factory on a compiled program: `open_runner(...)` returns an
+object with `frame() -> RenderResult` (render once, wait for completion, read back),
+`release()` and `shader`, the record of what it runs.
 
 The backends are the targets' (implc/targets.py), plus the exact CPU reference, which
 belongs to no target and runs no method.
@@ -13,15 +14,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
 from ..errors import InputError
-from ..targets import TARGETS, Backend, resolve
+from ..targets import TARGETS, Backend, Target, resolve
 
 if TYPE_CHECKING:  # the command line reads BACKENDS without sympy or numpy
+    from ..emit import CompiledShader
     from ..methods import Constants
+    from ..scene import View
     from ..surface import Surface
     from .result import RenderResult
 
 
 class Runner(Protocol):
+    shader: CompiledShader | None  # the program it runs (None: the CPU reference)
+
     def warm_up(self) -> float | None: ...  # seconds of the first use (None: no driver)
 
     def frame(self) -> RenderResult: ...
@@ -36,6 +41,8 @@ class Runner(Protocol):
 
 class _ReferenceRunner:
     """The exact CPU reference; it has no method, so `method` and `constants` are ignored."""
+
+    shader = None
 
     def __init__(self, surface: Surface, width: int, height: int):
         self.surface, self.width, self.height = surface, width, height
@@ -68,17 +75,41 @@ def open_runner(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
     params: str = "constant",
 ) -> Runner:
-    """`params="uniform"`: the program reads the parameters from uniforms, set from the
+    """Compile the backend's program (`compile_backend_shader`) and open its runner;
+    `params="uniform"`: the program reads the parameters from uniforms, set from the
     surface's values (the CPU reference always uses the values as they are)."""
     if backend == REFERENCE:
         return _ReferenceRunner(surface, width, height)
-    if backend not in BACKENDS:
-        choices = ", ".join([*BACKENDS, REFERENCE])
-        raise ValueError(f"unknown backend '{backend}'; choose from {choices}")
-    factory = resolve(BACKENDS[backend].runner)
-    if params == "constant":  # every factory's signature, as before
-        return factory(surface, method, constants, width, height)
-    return factory(surface, method, constants, width, height, params=params)
+    shader = compile_backend_shader(surface, backend, method, constants, params)
+    return open_shader_runner(shader, backend, surface.view, width, height)
+
+
+def compile_backend_shader(surface: Surface, backend: str, method: str, constants: Constants,
+                           params: str = "constant") -> CompiledShader:
+    """The program `backend` runs: its target's default flavour at its precision."""
+    from ..emit import compile_shader
+
+    target = backend_target(backend)
+    return compile_shader(surface, target.name, method, constants, target.default_flavor,
+                          precision=BACKENDS[backend].precision, params=params)
+
+
+def open_shader_runner(shader: CompiledShader, backend: str, view: View, width: int,
+                       height: int) -> Runner:
+    """The runner of `backend` on a compiled program (`compile_backend_shader`'s)."""
+    backend_target(backend)
+    runner = resolve(BACKENDS[backend].runner)(shader, view, width, height)
+    runner.shader = shader  # what it runs, for the sidecar and the API's record
+    return runner
+
+
+def backend_target(backend: str) -> Target:
+    """The target whose program `backend` runs."""
+    for target in TARGETS.values():
+        if backend in target.backends:
+            return target
+    choices = ", ".join([*BACKENDS, REFERENCE])
+    raise ValueError(f"unknown backend '{backend}'; choose from {choices}")
 
 
 def backend_for(backend: str, precision: str | None) -> str:
@@ -99,13 +130,18 @@ def render(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
     params: str = "constant",
 ) -> RenderResult:
-    """Image and aux buffers of one frame. `timing` holds, in seconds, `setup` (implc's
-    emit and the driver's program build), `compile` (the program's first use, where a
-    driver may compile it: see `TimedRunner.warm_up`; not for the reference) and `frame`
-    (one frame after that first use: what every later frame costs)."""
+    """Image and aux buffers of one frame (`run_frame` on a runner `open_runner` opens)."""
     start = time.perf_counter()
     runner = open_runner(surface, backend, method, constants, width, height, params)
-    setup = time.perf_counter() - start
+    return run_frame(runner, time.perf_counter() - start)
+
+
+def run_frame(runner: Runner, setup: float) -> RenderResult:
+    """One frame of `runner`, then release it. `timing` holds, in seconds, `setup`
+    (implc's emit and the driver's program build, measured by the caller), `compile` (the
+    program's first use, where a driver may compile it: see `TimedRunner.warm_up`; not for
+    the reference) and `frame` (one frame after that first use: what every later frame
+    costs)."""
     try:
         first_use = runner.warm_up()
         result = runner.frame()
@@ -118,26 +154,22 @@ def render(
 
 
 def metadata(
-    surface: Surface, backend: str, method: str, constants: Constants, result: RenderResult,
-    params: str = "constant",
+    surface: Surface, backend: str, shader: CompiledShader | None, result: RenderResult,
 ) -> dict:
     """The JSON sidecar: enough to recompute every pixel's ray and to reproduce the run
-    (`evaluation` is the form the shader used, not `auto`)."""
-    if backend == REFERENCE:
-        method_json = {"name": REFERENCE}
+    (`evaluation` is the form the shader used, not `auto`; `shader` None: the reference)."""
+    if shader is None:
+        method_json: dict = {"name": REFERENCE}
     else:
-        from ..marcher import choose_form
-        from ..methods import get_method
-
-        form = choose_form(get_method(method), surface.expr, constants.evaluation)
-        method_json = {"name": method, **constants.as_dict(), "evaluation": form}
+        method_json = {"name": shader.method, **shader.constants.as_dict(),
+                       "evaluation": shader.form}
     return {
         "surface": {
             "name": surface.name,
             "equation": surface.equation,
             "params": surface.params_json(),
         },
-        "params": params,
+        "params": "constant" if shader is None else shader.params,
         "camera": surface.view.camera_json(result.width, result.height),
         "clip": surface.view.clip_json(),
         "method": method_json,
@@ -155,11 +187,12 @@ def render_surface(
     surface: Surface, backend: str, method: str, constants: Constants, width: int, height: int,
     output: Path, params: str = "constant",
 ) -> tuple[list[Path], RenderResult]:
-    """Render and write the outputs; the paths written and the frame (its `timing`: see
-    `render`; its hits: what `implc render` reports)."""
+    """Render and write `output` and its JSON sidecar; the paths written and the frame."""
     from .image_io import write_render
 
-    result = render(surface, backend, method, constants, width, height, params)
-    paths = write_render(result, output,
-                         metadata(surface, backend, method, constants, result, params))
+    start = time.perf_counter()
+    runner = open_runner(surface, backend, method, constants, width, height, params)
+    shader = runner.shader
+    result = run_frame(runner, time.perf_counter() - start)
+    paths = write_render(result, output, metadata(surface, backend, shader, result))
     return paths, result

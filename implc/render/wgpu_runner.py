@@ -16,7 +16,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ..devices import wgpu_device
-from ..emit import ParamUniform, emit, param_uniforms
+from ..emit import CompiledShader, ParamUniform
 from ..errors import ToolError
 from ..scene import View
 from .result import RenderResult, TimedRunner
@@ -149,10 +149,8 @@ class WgpuRunner(TimedRunner):
         self.color.destroy()
 
 
-def open_wgpu_runner(surface, method, constants, width: int, height: int,
-                     params: str = "constant") -> WgpuRunner:
-    """Runner factory of backend `wgpu`: emit the WGSL program and compile it
-    (params="uniform": the parameters are uniform fields, moved by `set_params`)."""
-    program = emit(surface, "wgsl", method, constants, params=params)
-    uniforms = param_uniforms(surface, "wgsl") if params == "uniform" else ()
-    return WgpuRunner(program, surface.view, width, height, uniforms)
+def open_wgpu_runner(shader: CompiledShader, view: View, width: int,
+                     height: int) -> WgpuRunner:
+    """Runner factory of backend `wgpu`: compile the WGSL program (a `--params uniform`
+    shader's parameters are uniform fields, moved by `set_params`)."""
+    return WgpuRunner(shader.text, view, width, height, shader.uniforms)

@@ -1,0 +1,165 @@
+"""The records the API returns: a compiled shader and a rendering.
+
+Both are immutable and carry what the pipeline decided (the method, the evaluation form,
+the view, the uniforms) and what a user should know (`warnings`, `notes`), so no client
+decides it again. A Rendering shows itself in Jupyter (`_repr_png_`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..emit import CompiledShader
+from ..errors import ValidationError
+from ..fileio import write_atomic
+from ..scene import View
+from ..targets import get_target
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..render.result import RenderResult
+    from ..surface import Surface as SurfaceRecord
+    from ..validate import Verdict
+
+
+@dataclass(frozen=True)
+class Shader(CompiledShader):
+    """A compiled shader: `text`, and the `target`, `method`, evaluation `form`, `flavor`,
+    `precision`, `emit` form, `prefix`, `uniforms` and `constants` it was compiled with.
+    `warnings` are what a user should know about its pictures (float32 that cannot hold
+    the surface, a constant the method does not read); `notes` what was chosen for it
+    (the framing)."""
+
+    float32: str | None = None  # the float32 measure's finding alone (the CLI's remedy)
+
+    @classmethod
+    def of(cls, compiled: CompiledShader, **changes: Any) -> Shader:
+        fields = {f.name: getattr(compiled, f.name) for f in dataclasses.fields(compiled)}
+        return cls(**{**fields, **changes})
+
+    def __str__(self) -> str:
+        return self.text
+
+    @property
+    def extension(self) -> str:
+        """The file extension this shader is saved with (`.frag`, `.wgsl`, `.cl`, ...)."""
+        return get_target(self.target).emit_extensions[self.emit]
+
+    def validate(self, name: str | None = None) -> Verdict:
+        """Compile the text with its language's real compiler (glslangValidator, naga,
+        PoCL, glslang's HLSL front end); raise ValidationError with the tool's messages
+        if it refuses, else return the verdict."""
+        from ..validate import validate_text
+
+        name = name or f"<{self.method}>{self.extension}"
+        verdict = validate_text(self.text, self.target, name)
+        if not verdict.ok:
+            raise ValidationError(verdict.render(name))
+        return verdict
+
+    def save(self, path: str | Path) -> Path:
+        """Write the text to `path` (atomically: no partial file) and return the path."""
+        path = Path(path)
+        write_atomic(path, self.text)
+        return path
+
+
+@dataclass(frozen=True)
+class Rendering:
+    """One frame of a surface: `image` (uint8, height x width x 3, row 0 on top), `aux`
+    (per pixel: hit, t, steps, |S| at the hit), `hit_fraction`, the `view` it was taken
+    from, `timing` (seconds: setup, compile, frame), and `warnings` and `notes`."""
+
+    surface: SurfaceRecord  # the framed surface it shows
+    backend: str
+    shader: Shader | None  # None: the CPU reference, which runs no shader
+    result: RenderResult
+    picture_warnings: tuple[str, ...] = ()  # about the picture: nothing hit, clipped
+    notes: tuple[str, ...] = ()
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """What a user should know: the picture's warnings, then its shader's."""
+        return self.picture_warnings + (self.shader.warnings if self.shader else ())
+
+    @property
+    def method(self) -> str:
+        return "reference" if self.shader is None else self.shader.method
+
+    @property
+    def view(self) -> View:
+        return self.surface.view
+
+    @property
+    def width(self) -> int:
+        return self.result.width
+
+    @property
+    def height(self) -> int:
+        return self.result.height
+
+    @property
+    def color(self) -> np.ndarray:
+        """float32, height x width x 3, in [0, 1]."""
+        return self.result.color
+
+    @property
+    def image(self) -> np.ndarray:
+        """The picture as a PNG holds it: uint8, clipped and rounded."""
+        import numpy as np
+
+        image: np.ndarray = np.round(np.clip(self.result.color, 0.0, 1.0) * 255.0)
+        return image.astype(np.uint8)
+
+    @property
+    def aux(self) -> dict[str, np.ndarray]:
+        """hit (bool), t (distance from the eye), steps, residual (|S| at the hit)."""
+        r = self.result
+        return {"hit": r.hit, "t": r.t, "steps": r.steps, "residual": r.residual}
+
+    @property
+    def hit_fraction(self) -> float:
+        return float(self.result.hit.mean())
+
+    @property
+    def timing(self) -> dict[str, float]:
+        return dict(self.result.timing)
+
+    def metadata(self) -> dict[str, Any]:
+        """The JSON sidecar: camera, surface, method and timing, enough to recompute
+        every pixel's ray."""
+        from ..render.run import metadata
+
+        return metadata(self.surface, self.backend, self.shader, self.result)
+
+    def save(self, path: str | Path) -> list[Path]:
+        """Write `path` (.png for people, .exr with R G B A Z steps for tools) and the JSON
+        sidecar beside it; the paths written."""
+        from ..fileio import check_output
+        from ..render.image_io import write_render
+
+        path = Path(path)
+        check_output(path, (".png", ".exr"), what="a render",
+                     companions=[path.with_suffix(".json")])
+        return write_render(self.result, path, self.metadata())
+
+    def png(self) -> bytes:
+        """The picture as PNG bytes."""
+        import io
+
+        from PIL import Image
+
+        buffer = io.BytesIO()
+        Image.fromarray(self.image, "RGB").save(buffer, format="PNG")
+        return buffer.getvalue()
+
+    def _repr_png_(self) -> bytes:
+        return self.png()
+
+    def __repr__(self) -> str:
+        return (f"<Rendering {self.surface.name!r} {self.width}x{self.height} "
+                f"{self.backend}/{self.method}: {100 * self.hit_fraction:.1f} % hit>")

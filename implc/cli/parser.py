@@ -1,0 +1,95 @@
+"""The command line's parser: the top-level `implc` parser, whose commands each add their
+own arguments (implc/cli/cmd_*.py), and argparse's errors as one-line usage errors."""
+
+from __future__ import annotations
+
+import argparse
+import re
+
+from ..version import __version__
+from .args import UsageError
+
+EPILOG = """\
+surfaces: a TOML file, a SURFER .jsurf file, a bundled example name (see `implc list`),
+or -e "EQUATION".
+
+examples:
+  implc list
+  implc show cross-cap
+  implc compile cross-cap -t glsl -m hessian -o cross-cap.frag --validate
+  implc compile -e "x^2 + y^2 + z^2 = 1" -m taylor --flavor shadertoy
+  implc compile cross-cap --emit library --prefix cc_ -o cc.glsl
+  implc validate cross-cap.frag
+  implc render cross-cap -m hessian --size 512 -o cross-cap.png
+  implc view torus -o torus.html
+  implc compare cc-hessian.exr cc-reference.exr
+  implc bench cross-cap miter steiner --size 512 -o results/
+
+exit codes: 0 ok, 1 bad input or output (file missing, unreadable or unwritable,
+            disk full), 2 bad command line, 3 validation failed, 4 tool or runtime
+            missing, 70 internal error (IMPLC_DEBUG=1 shows the traceback),
+            130 interrupted (SIGINT), 143 terminated (SIGTERM)
+"""
+
+VIEW_POINT_FLAGS = ("--center", "--eye", "--look-at", "--up")  # values may start with '-'
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, with its errors raised as UsageError (main prints them in one line)."""
+
+    def error(self, message: str):  # type: ignore[override]
+        raise UsageError(message, self.prog)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The whole command line; each command module adds its own sub-parser (they import
+    nothing heavy at the top, so `--help` stays fast)."""
+    from .cmd_bench import add_parser as add_bench
+    from .cmd_compare import add_parser as add_compare
+    from .cmd_compile import add_parser as add_compile
+    from .cmd_corpus import add_parser as add_corpus
+    from .cmd_gallery import add_parser as add_gallery
+    from .cmd_list import add_parser as add_list
+    from .cmd_render import add_parser as add_render
+    from .cmd_show import add_parser as add_show
+    from .cmd_validate import add_parser as add_validate
+    from .cmd_view import add_parser as add_view
+
+    parser = Parser(
+        prog="implc",
+        description="Compile implicit-surface equations into robust GPU ray-marching shaders.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"implc {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for add in (add_list, add_show, add_compile, add_validate, add_render, add_view,
+                add_compare, add_bench, add_corpus, add_gallery):
+        add(sub)
+    return parser
+
+
+def join_equation_values(argv: list[str]) -> list[str]:
+    """`-e "-x^2 + z"` -> `--equation=-x^2 + z`.
+
+    argparse reads a separate value that starts with '-' as an option and reports
+    "expected one argument", but equations often start with a minus sign (a quarter of
+    the MathMod rows do). A value that looks like a long option (`--help`) is left alone.
+    """
+    joined: list[str] = []
+    i = 0
+    while i < len(argv):
+        arg = argv[i]
+        value = argv[i + 1] if i + 1 < len(argv) else None
+        if (arg in ("-e", "--equation") and value is not None and value.startswith("-")
+                and not re.match(r"--[A-Za-z]", value)):
+            joined.append(f"--equation={value}")
+            i += 2
+            continue
+        if arg in VIEW_POINT_FLAGS and value is not None and re.match(r"-[\d.xyzXYZ]", value):
+            joined.append(f"{arg}={value}")  # `--eye -3,0,0`, `--up -z`
+            i += 2
+            continue
+        joined.append(arg)
+        i += 1
+    return joined

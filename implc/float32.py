@@ -1,0 +1,89 @@
+"""How far float32 rounding moves a polynomial surface: the warning `compile`, `render`
+and `view` give (and the API's records carry), and the measures `implc show` prints.
+
+Two measures (implc/conditioning.py): S at sampled points of the surface, which speaks for
+every method, and exact's ray coefficients on the view's pixel rays, which follows exact's
+own share of wrong pixels. Both need numpy; `float32_warning` says when it is missing
+instead of failing a compile that needs only sympy and jinja2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy
+
+from .conditioning import (
+    RAY_WARN_SHARE,
+    WARN_SHARE,
+    Conditioning,
+    float32_conditioning,
+    ray_conditioning,
+)
+from .derive import polynomial_degree
+from .options import EXACT_MAX_DEGREE, T_TOL
+from .raypoly import coefficient_program
+from .scene import View
+from .solver import ROBUST_NEWTON_BELOW
+from .surface import Surface
+from .symbols import POINT
+
+
+@dataclass(frozen=True)
+class Float32Report:
+    """Both measures of a polynomial surface, each None where it does not apply."""
+
+    point: Conditioning | None  # S at sampled points of the surface: every method
+    ray: Conditioning | None  # exact's ray coefficients on the view's pixel rays
+
+    @property
+    def point_warns(self) -> bool:
+        return self.point is not None and self.point.far >= WARN_SHARE
+
+    @property
+    def ray_warns(self) -> bool:
+        return self.ray is not None and self.ray.far >= RAY_WARN_SHARE
+
+    def warning(self, method: str) -> str | None:
+        """What float32 does to `method`'s picture where a measure says it is too far
+        (None where none does): for exact its own coefficients' share, which follows its
+        share of wrong pixels, else S's: the line `compile`, `render` and `view` print
+        (`implc show` prints both measures in full)."""
+        if method == "exact" and self.ray_warns:
+            return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
+                    f"moves the first root by more than {T_TOL:g} on "
+                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (expect about "
+                    "that share of wrong pixels)")
+        if self.point_warns:
+            return (f"float32 cannot hold this surface: a rounding of S moves it by more "
+                    f"than {T_TOL:g} at {100 * self.point.far:.1f} % of its sampled points "
+                    "(expect wrong pixels from every method)")
+        return None
+
+
+def float32_report(expr: sympy.Expr, view: View, degree: int,
+                   gradient: tuple[sympy.Expr, ...] | None = None,
+                   point: bool = True) -> Float32Report:
+    """The ray coefficients' measure where exact's Newton reads F from them (degree
+    ROBUST_NEWTON_BELOW to EXACT_MAX_DEGREE), and S's at any degree unless `point` is
+    False (0.04-0.3 s: what a warning for exact alone does not need)."""
+    ray = (ray_conditioning(coefficient_program(expr, "float"), view)
+           if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
+    if not point:
+        return Float32Report(None, ray)
+    if gradient is None:
+        gradient = tuple(sympy.diff(expr, v) for v in POINT)
+    return Float32Report(float32_conditioning(expr, gradient), ray)
+
+
+def float32_warning(surface: Surface, method: str) -> str | None:
+    """The warning where float32 cannot hold a polynomial surface for `method` (None where
+    it can, or the surface is not a polynomial). exact's warning from degree
+    ROBUST_NEWTON_BELOW is its own coefficients' (S's measure at sampled points costs
+    0.04-0.3 s more and speaks for every method)."""
+    degree = polynomial_degree(surface.expr)
+    if degree is None:
+        return None
+    report = float32_report(surface.expr, surface.view, degree,
+                            point=method != "exact" or degree < ROBUST_NEWTON_BELOW)
+    return report.warning(method)
