@@ -104,10 +104,10 @@ def test_surfaces_are_immutable_records():
 def test_public_names_do_not_hide_modules():
     """A public name that is also a module's (implc.corpus) would be shadowed by the
     module once imported, or shadow it (`from implc import corpus`)."""
-    package = ROOT / "implc"
-    for name in implc.__all__:
-        assert not (package / f"{name}.py").exists(), name
-        assert not (package / name).is_dir(), name
+    for package in (ROOT / "implc", ROOT / "implc" / "api"):
+        for name in implc.__all__:
+            assert not (package / f"{name}.py").exists(), (package, name)
+            assert not (package / name).is_dir(), (package, name)
 
 
 def test_a_big_surface_is_framed_and_rendered():

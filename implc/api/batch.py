@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from ..bench import BenchRun
     from ..corpus import Row, RowResult
     from ..limits import Limits
-    from .gallery import Cell
+    from .contact_sheet import Cell
 
 
 def gallery(surfaces: Sequence[str], out_dir: str | Path, *, size: int = 160,
@@ -28,7 +28,7 @@ def gallery(surfaces: Sequence[str], out_dir: str | Path, *, size: int = 160,
     """Render each surface file or example name as a thumbnail with its default method
     and write index.html, contact-sheet.png and each surface's viewer page into
     `out_dir`; the cells (a failed surface's cell holds its error)."""
-    from .gallery import run_gallery
+    from .contact_sheet import run_gallery
 
     return run_gallery(list(surfaces), Path(out_dir), size=size, backend=backend,
                        webgpu=webgpu, stream=progress, executor=executor)
