@@ -51,8 +51,8 @@ def benchmark(surfaces: Sequence[str], out_dir: str | Path, *, size: int = 1024,
         if key in framed:
             raise InputError(f"surface '{key}' is given twice")
         surface = Surface.load(spec)
-        for note in surface.notes:
-            print(note, file=progress or sys.stderr)
+        for note in surface.notes if progress is not None else ():
+            print(note, file=progress)
         framed[key] = surface.framed()[0]
     return run_bench(framed, Path(out_dir), size=size, methods=methods or DEFAULT_METHODS,
                      frames=frames, backend=backend, configs=configs or CONFIG_NAMES,
