@@ -154,6 +154,9 @@ class Method:
     # interval: no step rule or root test; F's enclosure over a segment decides
     # (implc/interval.py, templates/interval.j2)
     bounds: bool = False
+    # how a method that takes no steps finds roots, in a few words (the viewer shows it
+    # where a marcher shows its step)
+    unmarched: str = ""
 
     @property
     def reads_taylor2(self) -> bool:
@@ -215,11 +218,12 @@ METHODS: dict[str, Method] = {
                paper_column="Hessian Approximate"),
         Method("exact", "polynomial S: the first real root of the ray polynomial, isolated "
                "exactly (monotonic pieces between critical points; no marching)",
-               solves=True),
+               solves=True, unmarched="no marching: exact root isolation"),
         # F and F' are sampled for the refinement only
         Method("interval", "any S: segments where F's interval enclosure excludes 0 are "
                "skipped, the others halved down to the leaf, where F's sign change is "
-               "refined (no sign change missed)", (F(S), DF(S), sympy.S.Zero), bounds=True),
+               "refined (no sign change missed)", (F(S), DF(S), sympy.S.Zero), bounds=True,
+               unmarched="no marching: interval bisection"),
     )
 }
 

@@ -181,6 +181,28 @@ def test_first_frame_is_the_reference_render(browser, tmp_path):
     assert all(not url.startswith(("http:", "https:")) for url in requests), requests
 
 
+@pytest.mark.parametrize(("example", "method", "step"), [
+    ("gyroid", None, "no marching: interval bisection"),  # its default: interval
+    ("torus", "exact", "no marching: exact root isolation"),
+    ("torus", "taylor", "b = 0.01"),
+])
+def test_each_method_names_how_it_finds_roots(browser, tmp_path, example, method, step):
+    """The readout under the method: a marcher's step, else the method's own way (the
+    interval method is not an exact root isolation)."""
+    page_path = write_page(tmp_path, example, method=method, webgpu=False)
+    with open_page(browser, file_url(page_path, f"size={SMALL}")) as (page, log):
+        wait_idle(page)
+        shown = page.locator("#step").inner_text()
+        problems = log.problems()
+    assert shown == step and problems == []
+
+
+def test_a_method_without_steps_says_how_it_finds_roots():
+    for method in METHODS.values():
+        marches = not (method.solves or method.bounds)
+        assert bool(method.unmarched) != marches, method.name
+
+
 @pytest.mark.parametrize(("example", "name", "value"), [
     ("torus", "r", "0.55"),
     ("torus", "R", "0.7"),

@@ -41,7 +41,7 @@
   $("equation").textContent = DATA.surface.equation;
   $("method").textContent = DATA.method.name + (DATA.method.uses_taylor2 ? " (Eq. 4: " + DATA.method.taylor2 + ")" : "");
   $("method").title = DATA.method.summary;
-  $("step").textContent = DATA.method.step === null ? "no marching: exact root isolation" : "b = " + DATA.method.step;
+  $("step").textContent = DATA.method.step === null ? DATA.method.unmarched : "b = " + DATA.method.step;
   if (fixedSize) stage.classList.add("fixed");
 
   function showError(message) {
