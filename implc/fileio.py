@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import itertools
 import os
 import shutil
 import tempfile
@@ -61,16 +62,19 @@ def check_output(
     *,
     what: str = "output",
     companions: Sequence[Path] = (),
+    sidecars: Sequence[str] = (),
 ) -> Path:
     """Check, before any work, that `path` can be written as a file.
 
     `extensions` (".png", ".exr", ...) are the ones this output may have (case-insensitive);
-    `companions` are files written beside it (a render's JSON sidecar), checked alike.
+    `companions` are files written beside it, checked alike; `sidecars` the suffixes of
+    files named after it (a render's `.json`), named once `path` is known to name a file.
     Probes the directory with a real temporary file (removed again), so a read-only
     file system or missing permissions show up even for root.
     """
     path = Path(path)
-    for target in (path, *companions):  # first: `-o adir` is a directory, whatever its name
+    named = (path.with_suffix(suffix) for suffix in sidecars)  # after path: `-o .` has no name
+    for target in itertools.chain((path, *companions), named):  # `-o adir`: a directory
         if target.is_dir():
             example = f"; name a file in it, e.g. {path / ('out' + extensions[0])}" if (
                 extensions and target == path) else ""

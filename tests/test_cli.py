@@ -345,6 +345,15 @@ def test_render_output_is_checked_before_rendering(tmp_path, output, message):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_render_to_the_current_directory_is_an_output_error(tmp_path):
+    """`-o .` names a directory: exit 1 with the fix, not an internal error (issue 44)."""
+    proc = implc("render", "sphere", "--size", "16", "-o", ".", cwd=tmp_path)
+    assert proc.returncode == 1, proc.stderr
+    assert _one_error_line(proc) == ("implc: error: cannot write .: it is a directory; name a "
+                                     "file in it, e.g. out.png")
+    assert list(tmp_path.iterdir()) == []
+
+
 # every extension `compile -o` writes, of every target of the registry, as listed
 _EXTENSIONS = [ext for t in TARGETS.values() for ext in t.compile_extensions]
 EVERY_EXTENSION = ", ".join(_EXTENSIONS[:-1]) + " or " + _EXTENSIONS[-1]

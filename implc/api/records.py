@@ -144,7 +144,7 @@ class Rendering:
 
         path = Path(path)
         check_output(path, (".png", ".exr"), what="a render",
-                     companions=[path.with_suffix(".json")])
+                     sidecars=(".json",))
         return write_render(self.result, path, self.metadata())
 
     def png(self) -> bytes:

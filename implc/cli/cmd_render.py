@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     width, height = _size(args)
     backend = _backend(args)
     check_output(args.output, (".png", ".exr"), what="a render",
-                 companions=[args.output.with_suffix(".json")])
+                 sidecars=(".json",))
     surface = common.surface(args)
     record, _ = surface.framed(width / height)
     method = args.method or surface.default_method
