@@ -45,6 +45,13 @@ CONSTANTS = ["--step", "--tau1", "--tau2", "--tau3", "--eps"]
 # (argv, what the message must say); OUT is a scratch directory
 BAD_OPTIONS = [
     (["compile", "sphere", "-m", "nope"], "invalid choice: 'nope'"),
+    # issue 44: an unknown option is the command's error, with the closest option or choice
+    (["render", "sphere", "--sise", "96", "-o", "OUT/a.png"],
+     "unrecognized arguments: --sise 96; did you mean '--size'?"),
+    (["compile", "sphere", "-m", "hesian"], "; did you mean 'hessian'?"),
+    (["rendr", "sphere"], "invalid choice: 'rendr' (choose from 'list', 'show', 'compile', "
+                          "'validate', 'render', 'view', 'compare', 'bench', 'corpus', "
+                          "'gallery'); did you mean 'render'?"),
     (["compile", "sphere", "-t", "bogus"], "invalid choice: 'bogus'"),
     (["compile", "sphere", "--flavor", "300es"],
      "--flavor: unknown glsl flavour '300es'; choose from 330, 450, es300, shadertoy"),

@@ -31,7 +31,7 @@ from .cmd_render import run as cmd_render
 from .cmd_show import run as cmd_show
 from .cmd_validate import run as cmd_validate
 from .cmd_view import run as cmd_view
-from .parser import build_parser, join_equation_values
+from .parser import build_parser, join_equation_values, unknown_options
 from .process import GuardedStdout, exit_code, install_signals, restore_signals
 
 
@@ -48,8 +48,11 @@ def _main(argv: list[str] | None) -> int:
     try:
         raise_dropped()  # one that came while the modules loaded
         parser = build_parser()
-        args = parser.parse_args(join_equation_values(sys.argv[1:] if argv is None else argv))
+        args, extra = parser.parse_known_args(
+            join_equation_values(sys.argv[1:] if argv is None else argv))
         command = args.command or "implc"
+        if extra:
+            raise unknown_options(parser, args.command, extra)
         if not args.command:
             parser.print_help()
             return EXIT_OK

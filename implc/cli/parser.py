@@ -4,6 +4,7 @@ own arguments (implc/cli/cmd_*.py), and argparse's errors as one-line usage erro
 from __future__ import annotations
 
 import argparse
+import difflib
 import re
 
 from ..version import __version__
@@ -35,10 +36,34 @@ VIEW_POINT_FLAGS = ("--center", "--eye", "--look-at", "--up")  # values may star
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse, with its errors raised as UsageError (main prints them in one line)."""
+    """argparse, with its errors raised as UsageError (main prints them in one line), and
+    a did-you-mean for a choice that is close to one (`implc rendr`, `-m hesian`)."""
 
     def error(self, message: str):  # type: ignore[override]
+        choice = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+        if choice:
+            choices = re.findall(r"'([^']*)'", choice.group(2))
+            message += did_you_mean(choice.group(1), choices)
         raise UsageError(message, self.prog)
+
+
+def did_you_mean(word: str, choices: list[str]) -> str:
+    """"; did you mean 'render'?" when one of `choices` is close to `word`, else ""."""
+    close = difflib.get_close_matches(word, choices, n=1, cutoff=0.6)
+    return f"; did you mean '{close[0]}'?" if close else ""
+
+
+def unknown_options(parser: argparse.ArgumentParser, command: str | None,
+                    extra: list[str]) -> UsageError:
+    """The error for arguments no option of `command` takes, named by the command, with
+    the closest option (`--sise 96`: did you mean '--size'?)."""
+    prog, options = "implc", list(parser._option_string_actions)
+    if command:
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+        prog, options = f"implc {command}", list(sub.choices[command]._option_string_actions)
+    first = next((arg.split("=", 1)[0] for arg in extra if arg.startswith("-")), "")
+    hint = did_you_mean(first, options) if first else ""
+    return UsageError(f"unrecognized arguments: {' '.join(extra)}{hint}", prog)
 
 
 def build_parser() -> argparse.ArgumentParser:
