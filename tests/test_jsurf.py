@@ -259,6 +259,20 @@ def test_gallery(tmp_path):
     assert "[3/3]" in proc.stderr  # progress lines (a bar with ETA on a terminal)
 
 
+def test_gallery_says_a_note_once(tmp_path):
+    """The same note of several files (their ignored keys) is said once, naming them; one
+    surface is "1 surface" (issue 44)."""
+    files = [str(DATA / name)
+             for name in ("kugel.jsurf", "dingdong.jsurf", "kummer_quartic.jsurf")]
+    proc = run("gallery", *files, "--size", "16", "-o", str(tmp_path / "g"))
+    assert proc.returncode == 0, proc.stderr
+    ignored = [line for line in proc.stderr.splitlines() if "ignored (implc does not" in line]
+    assert len(ignored) == 1 and ignored[0].startswith("implc: note: 3 files ("), ignored
+    assert all(name in ignored[0] for name in files)
+    proc = run("gallery", "torus", "--size", "16", "-o", str(tmp_path / "one"))
+    assert proc.returncode == 0 and "(1 surface)" in proc.stdout, proc.stdout
+
+
 def test_gallery_page_in_chromium(browser, tmp_path):
     """index.html as a browser shows it: every thumbnail loads at its size, every link
     points at a file the run wrote, and a thumbnail opens its `implc view` page."""

@@ -73,20 +73,42 @@ def run_gallery(specs: list[str], out_dir: Path, size: int = 160, backend: str =
             results = (future.result() for future in futures)
         for one in results:
             made.append(one)
-            for note in one.notes:
-                bar.note(note)
             cell = one.cell
             if one.png is not None:
                 write_atomic(stage / f"{cell.stem}.png", one.png)
                 write_atomic(stage / f"{cell.stem}.html", one.page)
             bar.step(cell.error.splitlines()[0] if cell.error else
                      f"{cell.name or cell.spec}: {cell.method}, {cell.frame_ms:.1f} ms")
+        for note in merged_notes([note for one in made for note in one.notes]):
+            bar.note(note)
         cells = [one.cell for one in made]
         write_atomic(stage / "index.html", render_template(
             "gallery/index.html.j2", cells=[dataclasses.asdict(c) for c in cells],
             size=size, backend=backend))
         _write_sheet(stage / "contact-sheet.png", made, size)
     return cells
+
+
+_NOTE = re.compile(r"(implc: note: )(.+?): (.*)", re.S)
+
+
+def merged_notes(notes: list[str]) -> list[str]:
+    """Each load note once: the same note of several files (a .jsurf file's ignored
+    keys) names the files together instead of repeating itself per file."""
+    files: dict[tuple[str, str], list[str]] = {}
+    for note in notes:
+        match = _NOTE.fullmatch(note)
+        head, name, rest = match.groups() if match else ("", "", note)
+        files.setdefault((head, rest), []).append(name)
+    merged = []
+    for (head, rest), names in files.items():
+        if len(names) == 1:
+            merged.append(f"{head}{names[0]}: {rest}" if names[0] else rest)
+        else:
+            shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3
+                                            else "")
+            merged.append(f"{head}{len(names)} files ({shown}): {rest}")
+    return merged
 
 
 def make_cell(spec: str, stem: str, size: int, backend: str, webgpu: bool) -> Made:

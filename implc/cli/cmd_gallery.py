@@ -40,6 +40,7 @@ def run(args: argparse.Namespace) -> int:
         cells = gallery(args.surfaces, args.output, size=args.size, backend=args.backend,
                         webgpu=args.webgpu, executor=executor)
     failed = sum(1 for cell in cells if cell.error)
-    print(f"wrote {args.output / 'index.html'} ({len(cells)} surfaces"
+    print(f"wrote {args.output / 'index.html'} ({len(cells)} "
+          f"surface{'' if len(cells) == 1 else 's'}"
           + (f", {failed} failed: see their cells" if failed else "") + ")")
     return EXIT_OK
