@@ -13,9 +13,14 @@ from .scene import point_text
 from .surface import Surface
 
 
-def picture_warnings(surface: Surface, result: RenderResult, given_radius: bool) -> list[str]:
+def picture_warnings(surface: Surface, result: RenderResult, given_radius: bool,
+                     max_steps: int | None = None) -> list[str]:
     """The warnings (and notes) about `result`, a picture of `surface` in its view;
-    `given_radius`: the caller set the clip sphere's radius."""
+    `given_radius`: the caller set the clip sphere's radius; `max_steps`: a marcher's step
+    cap (None: the method takes no steps)."""
+    capped = _capped(result, max_steps)
+    if capped:  # the rays ran out of steps: where the surface is may be right
+        return [capped]
     view = surface.view
     sphere = (f"the clip sphere (center {point_text(view.clip_center)}, radius "
               f"{view.clip_radius:g})")
@@ -45,3 +50,17 @@ def picture_warnings(surface: Surface, result: RenderResult, given_radius: bool)
     hint = f"--radius {extent.radius:g} holds all of it" if extent else "--radius to widen it"
     return [f"implc: warning: the surface reaches {sphere}: the picture is clipped there; "
             f"{hint}"]
+
+
+def _capped(result: RenderResult, max_steps: int | None) -> str | None:
+    """The warning where rays stopped at the step cap without a hit: their pixels show
+    background whether or not the surface is behind them (the aux buffer has the steps)."""
+    if max_steps is None:
+        return None
+    stopped = int(((result.steps >= max_steps) & ~result.hit).sum())
+    if stopped == 0:
+        return None
+    share = 100.0 * stopped / result.hit.size
+    return (f"implc: warning: {stopped:,} rays ({share:.1f} % of the pixels) stopped at "
+            f"--max-steps {max_steps} without finding the surface, so the picture may miss "
+            "it there: raise --step (the base step) or --max-steps")

@@ -354,6 +354,21 @@ def test_render_to_the_current_directory_is_an_output_error(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_rays_that_run_out_of_steps_are_said(tmp_path):
+    """A march that stops at --max-steps is named with its remedy, not blamed on the clip
+    radius (issue 44): a too small step hits nothing, a small one part of the torus."""
+    for step, hits in (("1e-30", "0.0 %"), ("1e-5", "%")):
+        out = tmp_path / f"t{step}.png"
+        proc = implc("render", "torus", "-m", "hessian", "--step", step, "--radius", "1.5",
+                     "--size", "24", "-o", str(out))
+        assert proc.returncode == 0, proc.stderr
+        assert f"{hits} of pixels hit" in proc.stderr
+        assert "stopped at --max-steps 20000 without finding the surface" in proc.stderr
+        assert "raise --step" in proc.stderr and "try --radius" not in proc.stderr
+    proc = implc("render", "torus", "-m", "hessian", "--size", "24", "-o", str(out))
+    assert proc.returncode == 0 and "max-steps" not in proc.stderr, proc.stderr
+
+
 # every extension `compile -o` writes, of every target of the registry, as listed
 _EXTENSIONS = [ext for t in TARGETS.values() for ext in t.compile_extensions]
 EVERY_EXTENSION = ", ".join(_EXTENSIONS[:-1]) + " or " + _EXTENSIONS[-1]

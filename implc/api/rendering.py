@@ -44,6 +44,7 @@ def render_surface(surface: Framable, size: int | None = 512, *, width: int | No
                    precision: str | None, params: str, constants: Mapping[str, Any]) -> Rendering:
     """`Surface.render`."""
     from ..framing import check_frame
+    from ..methods import METHODS
     from ..picture_checks import picture_warnings
     from ..render.run import (
         BACKENDS,
@@ -73,6 +74,9 @@ def render_surface(surface: Framable, size: int | None = 512, *, width: int | No
         notes = shader.notes
     result = run_frame(runner, time.perf_counter() - start)
     given_radius = surface.view_options.radius is not None
-    picture = tuple(picture_warnings(record, result, given_radius))
+    max_steps = None
+    if shader is not None and "max_steps" in METHODS[shader.method].reads:
+        max_steps = shader.constants.max_steps
+    picture = tuple(picture_warnings(record, result, given_radius, max_steps))
     return Rendering(record, backend, shader, result, picture, notes)
 
