@@ -107,10 +107,10 @@ def shading_for(view: View) -> Shading:
 #   (implc/extent.py), centred on it (or on `center`); when no surface is found the
 #   default view is kept and the caller says so;
 # - no `target`: the clip sphere's centre;
-# - no `eye`, and the radius is not the file's: the eye looks at the target from
-#   FRAME_DIRECTION, turned so that +y goes to `up`, at the distance where the clip
-#   sphere fills FRAME_FILL of the picture's shorter side. A file that sets `radius`
-#   and no `eye` keeps the default eye (3, 2, 4), as before framing existed.
+# - no `eye`: the eye looks at the target from FRAME_DIRECTION, turned so that +y goes
+#   to `up`, at the distance where the clip sphere fills FRAME_FILL of the picture's
+#   shorter side, wherever the radius came from (a file's `radius` without `eye` kept the
+#   default eye (3, 2, 4) once: a close-up cut by the frame, issue 44).
 
 FRAME_DIRECTION = (3.0, 2.0, 4.0)  # the default eye's direction, for up = +y
 FRAME_FILL = 0.9
@@ -195,7 +195,7 @@ def apply_view(
     up = pick(options.up, view.up)
     fov = pick(options.fov, view.fov_y_deg)
     framed_sphere = "radius" not in given
-    placed_eye = "eye" not in given and "radius" not in view.given
+    placed_eye = "eye" not in given
     extent = None
     if framed_sphere:
         extent = locate(center if "center" in given else None)

@@ -155,9 +155,26 @@ def test_command_line_radius_overrides_and_places_the_eye():
     assert framed.clip_radius == 4.0 and framing is not None and framing.placed_eye
 
 
-def test_a_file_radius_without_eye_keeps_the_default_eye():
-    view = View(clip_radius=1.2, given=frozenset({"radius"}))
-    assert apply_view(view, ViewOptions(), lambda c: pytest.fail("searched")) == (view, None)
+def test_a_file_radius_without_eye_places_the_eye():
+    """The eye follows the radius wherever it comes from (issue 44: a file's `radius = 3`
+    without `eye` kept the default eye (3, 2, 4), a close-up cut by the frame, while the
+    same radius from --radius was framed)."""
+    view = View(clip_radius=3.0, given=frozenset({"radius"}))
+    framed, framing = apply_view(view, ViewOptions(), lambda c: pytest.fail("searched"))
+    same, _ = apply_view(View(), ViewOptions(radius=3.0), lambda c: pytest.fail("searched"))
+    assert framing is not None and framing.placed_eye and not framing.framed_sphere
+    assert framed.eye == same.eye and framed.eye != (3.0, 2.0, 4.0)
+
+
+def test_a_file_radius_without_eye_renders_the_whole_sphere(tmp_path):
+    """A sphere of radius 2.9 in a clip sphere of radius 3 from the file, no eye: the
+    picture holds all of it (the default eye saw 74.5 % hits, a cropped close-up)."""
+    surface = tmp_path / "s.toml"
+    surface.write_text('equation = "x^2+y^2+z^2 = 2.9^2"\n[view]\nradius = 3\n')
+    proc, car = render(tmp_path, str(surface))
+    assert proc.returncode == 0, proc.stderr
+    assert "framed: eye" in proc.stderr
+    assert 45.0 < hit_percent(proc.stderr) < 65.0
 
 
 def test_command_line_options_override_the_file(tmp_path):
