@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
-from ..errors import EXIT_OK
+from ..errors import EXIT_INPUT, EXIT_OK
 from ..fileio import check_output_dir
 from ..render.run import BACKENDS, REFERENCE
 from . import args as common
@@ -43,4 +44,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.output / 'index.html'} ({len(cells)} "
           f"surface{'' if len(cells) == 1 else 's'}"
           + (f", {failed} failed: see their cells" if failed else "") + ")")
+    if failed:  # the sheet is written, but not every surface is on it (README "Exit codes")
+        print(f"implc gallery: error: {failed} of {len(cells)} surfaces failed (their errors "
+              "are in their cells)", file=sys.stderr)
+        return EXIT_INPUT
     return EXIT_OK
