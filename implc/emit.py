@@ -147,9 +147,8 @@ def check_shader_options(target: str, flavor: str | None = None,
         raise OptionError(f"unknown --params '{params}'; choose from "
                           f"{', '.join(PARAM_MODES)}")
     if params == "uniform" and tgt.flavors[flavor or tgt.default_flavor].get("shadertoy"):
-        # an input error (exit 1), as it has always been: the surface's parameters
-        raise InputError("the shadertoy flavour has no uniforms of its own: use "
-                         "--params constant (the default) with --flavor shadertoy")
+        raise OptionError("--params uniform: the shadertoy flavour has no uniforms of its "
+                          "own: use --params constant (the default) with --flavor shadertoy")
 
 
 def compile_shader(

@@ -115,7 +115,7 @@ def test_wgsl_uniform_program_and_library_validate():
 
 def test_uniform_refusals():
     surface = load_surface("torus")
-    with pytest.raises(InputError, match="shadertoy"):
+    with pytest.raises(OptionError, match="shadertoy"):  # contradicting options (issue 44)
         emit(surface, "glsl", flavor="shadertoy", params="uniform")
     with pytest.raises(OptionError, match="--params"):
         emit(surface, params="baked")
@@ -202,7 +202,9 @@ def test_cli_render_and_compile_take_params(tmp_path):
                  "--size", "32", "-o", str(out))
     assert proc.returncode == 0, proc.stderr
     proc = implc("compile", "torus", "--params", "uniform", "--flavor", "shadertoy")
-    assert proc.returncode == 1 and "shadertoy" in proc.stderr
+    # contradicting options: exit 2, the README's table (issue 44; it was 1)
+    assert proc.returncode == 2 and "shadertoy" in proc.stderr
+    assert proc.stderr.startswith("implc compile: error: --params uniform: the shadertoy")
 
 
 USER_KERNEL = """
