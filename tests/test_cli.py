@@ -354,6 +354,18 @@ def test_render_to_the_current_directory_is_an_output_error(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_files_params_take_constant_expressions_like_param(tmp_path):
+    """`c = "sqrt(2^2 - 1.9^2)"` in [params] is the value --param gives (issue 44)."""
+    path = tmp_path / "s.toml"
+    path.write_text('equation = "x^2 + y^2 + z^2 = c"\n[params]\nc = "sqrt(2^2 - 1.9^2)"\n')
+    from_file = implc("compile", str(path), "-t", "wgsl")
+    from_param = implc("compile", "-e", "x^2 + y^2 + z^2 = c", "--param",
+                       "c=sqrt(2^2 - 1.9^2)", "-t", "wgsl", "--radius", "1")
+    assert from_file.returncode == 0 and from_param.returncode == 0, from_file.stderr
+    shown = implc("show", str(path))
+    assert "with c = sqrt(39)/10" in shown.stdout, shown.stdout
+
+
 def test_rays_that_run_out_of_steps_are_said(tmp_path):
     """A march that stops at --max-steps is named with its remedy, not blamed on the clip
     radius (issue 44): a too small step hits nothing, a small one part of the torus."""
@@ -444,8 +456,12 @@ SURFACE_FAULTS = [
      "FILE:3:7: error: [view] fov must be a number, not a string"),
     ('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [1, 2]\n',
      "FILE:3:7: error: [view] eye must be 3 numbers, like [0.0, 0.0, 0.0]"),
-    ('equation = "x^2 + a"\n[params]\na = "big"\n',
-     "FILE:3:5: error: parameter 'a' must be a number, not a string"),
+    # issue 44: a quoted value is a constant expression, as --param takes it (a string was
+    # refused: "must be a number, not a string")
+    ('equation = "x^2 + a"\n[params]\na = "big"\n', "FILE:3:6: error: unknown name 'big'"),
+    ('equation = "x^2 + a"\n[params]\na = true\n',
+     "FILE:3:5: error: parameter 'a' must be a number or a constant expression in quotes, "
+     "not a boolean"),
     ('name = ["x"]\nequation = "x"\n', "FILE:1:8: error: name must be a string, not an array"),
     # escapes before the fault: the column is the file's (it was the key's column + offset)
     ('equation = "x^2 + \\t sinn(y)"\n',

@@ -30,7 +30,7 @@ import sympy
 
 from ..errors import InputError, Source
 from ..fileio import read_input
-from ..front import check_param_name, parse_number
+from ..front import check_param_name, parse_constant, parse_number
 from ..limits import Limits
 from ..scene import View, view_problems
 from ..surface import Surface
@@ -92,8 +92,12 @@ def load_toml(
     for key, value in sorted(table.items()):
         src = where.key_source(("params", key))
         check_param_name(key, src)
+        if isinstance(value, str):  # a constant expression, as --param takes it
+            values[key] = parse_constant(where.string_source(("params", key), value), limits)
+            continue
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise where.error(("params", key), f"parameter '{key}' must be a number, not "
+            raise where.error(("params", key), f"parameter '{key}' must be a number or a "
+                                              "constant expression in quotes, not "
                                               f"{_toml_type(value)}", value=True)
         values[key] = parse_number(repr(value), src)
     values.update(overrides)
