@@ -366,6 +366,27 @@ def test_a_files_params_take_constant_expressions_like_param(tmp_path):
     assert "with c = sqrt(39)/10" in shown.stdout, shown.stdout
 
 
+def test_a_file_that_is_not_a_surface_is_named(tmp_path):
+    """A shader, an image, a SURFER file named .toml: what it looks like and what implc
+    reads, not a bare TOML error or the image's bytes echoed (issue 44)."""
+    shader = tmp_path / "a.frag"
+    shader.write_text("#version 330 core\nvoid main() {}\n")
+    image = tmp_path / "render.exr"
+    image.write_bytes(b"\x76\x2f\x31\x01" + bytes(range(256)) * 4)
+    surfer = tmp_path / "kugel.toml"
+    surfer.write_text("surface_equation=x^2+y^2+z^2-1\ncamera_type=ORTHOGRAPHIC_CAMERA\n")
+    proc = implc("show", str(shader))
+    assert proc.returncode == 1 and "help: this looks like a shader" in proc.stderr
+    proc = implc("show", str(image))
+    assert proc.returncode == 1 and proc.stderr.splitlines() == [
+        f"implc: error: {image}: an OpenEXR image, not a surface file; implc reads surfaces "
+        "from TOML files (.toml), SURFER files (.jsurf), bundled example names (`implc "
+        "list`) and -e EQUATION"]
+    proc = implc("render", str(surfer), "-o", str(tmp_path / "k.png"))
+    assert proc.returncode == 1 and "help: this looks like a SURFER file" in proc.stderr
+    assert "name it .jsurf" in proc.stderr and not (tmp_path / "k.png").exists()
+
+
 def test_rays_that_run_out_of_steps_are_said(tmp_path):
     """A march that stops at --max-steps is named with its remedy, not blamed on the clip
     radius (issue 44): a too small step hits nothing, a small one part of the torus."""

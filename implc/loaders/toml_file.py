@@ -59,6 +59,9 @@ def load_toml(
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         raise InputError("not UTF-8 text: the file is UTF-16 (it starts with a byte order "
                          "mark); save it as UTF-8", Source(name, "", 1, 1))
+    kind = _binary_kind(raw)
+    if kind:  # named, not echoed: its bytes mean nothing on a terminal
+        raise InputError(f"{name}: {kind}, not a surface file; {READS}")
     try:
         # a byte order mark (Notepad's "UTF-8 with BOM") is not part of the text
         text = raw.decode("utf-8").removeprefix("\ufeff")
@@ -73,7 +76,9 @@ def load_toml(
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise _toml_error(name, text, err) from None
+        error = _toml_error(name, text, err)
+        error.help = _looks_like(text)
+        raise error from None
     where = _TomlMap(name, text)
     where.check_keys(data)
 
@@ -360,6 +365,37 @@ class _TomlMap:
 def _key_path(text: str) -> tuple[str, ...]:
     parts = re.findall(_KEY_PART, text)
     return tuple(p[1:-1] if p[:1] in ('"', "'") else p for p in parts)
+
+
+READS = ("implc reads surfaces from TOML files (.toml), SURFER files (.jsurf), bundled "
+         "example names (`implc list`) and -e EQUATION")
+
+# the first bytes of files a user may give by mistake, and what they are
+_MAGIC = ((b"\x89PNG\r\n\x1a\n", "a PNG image"), (b"\x76\x2f\x31\x01", "an OpenEXR image"),
+          (b"\xff\xd8\xff", "a JPEG image"), (b"\x03\x02\x23\x07", "a SPIR-V module"),
+          (b"%PDF", "a PDF document"), (b"PK\x03\x04", "a zip archive"))
+_SHADER = re.compile(r"^\s*#version\b|\bvoid\s+main\s*\(|@(compute|fragment|vertex)\b|"
+                     r"__kernel\b|\bfn\s+\w+\s*\(", re.M)
+_JSURF = re.compile(r"^\s*surface_equation\s*=", re.M)
+
+
+def _binary_kind(raw: bytes) -> str | None:
+    """What a binary file is (an image, a module), or None for text."""
+    for magic, kind in _MAGIC:
+        if raw.startswith(magic):
+            return kind
+    return "a binary file" if b"\0" in raw[:8192] else None
+
+
+def _looks_like(text: str) -> str | None:
+    """A hint for a text that is not TOML but another kind of file implc knows."""
+    if _JSURF.search(text):
+        return ("this looks like a SURFER file (surface_equation=...): name it .jsurf and "
+                "implc reads it as one")
+    if _SHADER.search(text):
+        return (f"this looks like a shader, not a surface file (`implc validate` checks "
+                f"shaders); {READS}")
+    return None
 
 
 def _toml_error(name: str, text: str, err: Exception) -> InputError:
