@@ -19,6 +19,7 @@ import errno
 import itertools
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
@@ -73,6 +74,8 @@ def check_output(
     file system or missing permissions show up even for root.
     """
     path = Path(path)
+    if is_device(path):  # `-o /dev/null`, `-o /dev/stdout`: written as they are
+        return path
     named = (path.with_suffix(suffix) for suffix in sidecars)  # after path: `-o .` has no name
     for target in itertools.chain((path, *companions), named):  # `-o adir`: a directory
         if target.is_dir():
@@ -127,13 +130,38 @@ def write_atomic(path: Path, data: str | bytes) -> None:
     write_with(path, lambda tmp: Path(tmp).write_bytes(payload))
 
 
-def write_with(path: Path, writer: Callable[[str], object]) -> None:
+def write_with(path: Path, writer: Callable[[str], object], suffix: str = "") -> None:
     """Let `writer(temp_path)` produce the file, then rename it onto `path` atomically.
 
-    The temporary keeps the target's extension (image writers choose the format by it).
+    The temporary keeps the target's extension (image writers choose the format by it;
+    `suffix` names the format for a device, which has none).
     """
+    if is_device(path):
+        write_device(path, writer, suffix)
+        return
     commit = prepare_with(path, writer)
     commit()
+
+
+def is_device(path: Path | str) -> bool:
+    """A character device (`/dev/null`, a terminal): written to, never replaced."""
+    try:
+        return stat.S_ISCHR(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+def write_device(path: Path | str, writer: Callable[[str], object], suffix: str = "") -> None:
+    """`writer` makes the file in a scratch directory; its bytes go to the device (a
+    rename would replace `/dev/null` itself)."""
+    with tempfile.TemporaryDirectory(prefix="implc-") as scratch:
+        staged = Path(scratch) / ("out" + (suffix or Path(path).suffix))
+        writer(str(staged))
+        try:
+            with open(path, "wb") as device:
+                device.write(staged.read_bytes())
+        except OSError as err:
+            raise OutputError(f"cannot write {path}: {_describe(err)}") from None
 
 
 def prepare_with(path: Path, writer: Callable[[str], object]) -> Callable[[], None]:

@@ -387,6 +387,21 @@ def test_a_file_that_is_not_a_surface_is_named(tmp_path):
     assert "name it .jsurf" in proc.stderr and not (tmp_path / "k.png").exists()
 
 
+def test_a_character_device_is_an_output(tmp_path):
+    """`-o /dev/null` is accepted and written as it is, never replaced (issue 44: it was
+    refused for having no extension); /dev/full shows the bytes really go to the device."""
+    import stat
+
+    for argv in (["compile", "torus"], ["view", "torus"], ["render", "torus", "--size", "16"]):
+        proc = implc(*argv, "-o", "/dev/null")
+        assert proc.returncode == 0, proc.stderr
+        assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+        proc = implc(*argv, "-o", "/dev/full")
+        assert proc.returncode == 1, proc.stderr
+        assert proc.stderr.splitlines()[-1] == ("implc: error: cannot write /dev/full: no "
+                                                "space left on the device"), proc.stderr
+
+
 def test_rays_that_run_out_of_steps_are_said(tmp_path):
     """A march that stops at --max-steps is named with its remedy, not blamed on the clip
     radius (issue 44): a too small step hits nothing, a small one part of the torus."""

@@ -67,14 +67,15 @@ def run(args: argparse.Namespace) -> int:
 
 def _target(args: argparse.Namespace, output: Path | None) -> str:
     """-t, else the language of -o's extension (read as `implc validate` reads it: `-o
-    x.wgsl` is WGSL), else glsl."""
+    x.wgsl` is WGSL), else glsl (also for a device such as /dev/null)."""
     if args.target is not None:
         return str(args.target)
     if output is None:
         return "glsl"
     every = tuple(ext for t in TARGETS.values() for ext in t.compile_extensions)
     check_output(output, every, what="a shader")  # a directory, or no language's
-    return target_of_file(output.suffix.lower()).name
+    found = target_of_file(output.suffix.lower())
+    return found.name if found else "glsl"  # a device (`-o /dev/null`) has no extension
 
 
 def _remedy(target: str, flavor: str | None) -> str:

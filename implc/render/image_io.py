@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputError
-from ..fileio import prepare_with
+from ..fileio import is_device, prepare_with, write_device
 from ..interrupts import signals_held
 from .result import RenderResult
 
@@ -32,6 +32,9 @@ def write_render(result: RenderResult, path: Path, metadata: dict) -> list[Path]
     The metadata is serialized first, so a bad value fails before any file is touched.
     """
     path = Path(path)
+    if is_device(path):  # `-o /dev/null`: the PNG alone, no sidecar beside a device
+        write_device(path, lambda tmp: _write_png(result, Path(tmp)), ".png")
+        return [path]
     sidecar = path.with_suffix(".json")
     text = json.dumps(metadata, indent=2, sort_keys=True, default=_json_value) + "\n"
     suffix = path.suffix.lower()
