@@ -10,6 +10,7 @@ supplies the same named quantities; methods only name what they need.
 
 from __future__ import annotations
 
+from fractions import Fraction
 from functools import cached_property, lru_cache
 
 import sympy
@@ -218,13 +219,103 @@ def _is_expanded_rational_polynomial(expr: sympy.Expr) -> bool:
 def polynomial_degree(expr: sympy.Expr) -> int | None:
     """Total degree in x, y, z, or None when S is not a polynomial.
 
-    Cached: one compile asks it for the default method, the evaluation form, the exact
-    method's check and the ray coefficients, and it is the costliest question of the
-    four (`Poly` expands S; over the reals, since front.build.fold_constants made every constant
-    a number)."""
+    Never by expanding S (`sympy.Poly` took 52 s on (x^2+...+1)^15, issue 44): S(a t, b t,
+    c t) = sum_k H_k(a, b, c) t^k, where H_k is S's part of degree k, is computed as a
+    polynomial in t by exact arithmetic over S's tree, at DEGREE_POINTS points (a, b, c)
+    of large pseudo-random integers; the degree is the largest k whose H_k is not 0 at
+    one of them. A nonzero H_k vanishes at a random such point with probability at most
+    k / 2^62 (Schwartz-Zippel), twice in a row practically never. Cached: one compile
+    asks it for the default method, the evaluation form, the exact method's check and
+    the ray coefficients."""
     if not expr.is_polynomial(*POINT):
         return None
-    return int(sympy.Poly(expr, *POINT).total_degree())
+    return max(_degree_at(expr, point) for point in DEGREE_POINTS)
+
+
+# fixed, so every run gives the same answer (a seeded generator's first values)
+DEGREE_POINTS = (
+    (3_861_104_215_836_297_113, 2_472_943_109_377_521_061, 4_088_163_735_906_174_891),
+    (1_314_979_623_087_211_433, 3_957_301_846_552_713_207, 2_700_531_458_219_304_389),
+)
+
+
+def _degree_at(expr: sympy.Expr, point: tuple[int, int, int]) -> int:
+    """deg_t S(a t, b t, c t), by truncated-free exact arithmetic on lists of Fractions
+    (index k: the coefficient of t^k), over the distinct sub-expressions of S."""
+    values = dict(zip(POINT, point, strict=True))
+    memo: dict[sympy.Basic, list[Fraction]] = {}
+    stack: list[tuple[sympy.Basic, bool]] = [(expr, False)]
+    while stack:
+        node, ready = stack.pop()
+        if node in memo:
+            continue
+        if not ready and node.args:
+            stack.append((node, True))
+            stack.extend((a, False) for a in node.args if a not in memo)
+            continue
+        memo[node] = _t_poly(node, [memo[a] for a in node.args], values)
+    coefficients = memo[expr]
+    return max((k for k, c in enumerate(coefficients) if c != 0), default=0)
+
+
+def _t_poly(node: sympy.Basic, parts: list[list[Fraction]],
+            values: dict[sympy.Symbol, int]) -> list[Fraction]:
+    if node in values:
+        return [Fraction(0), Fraction(values[node])]  # x = a t
+    if not node.free_symbols & values.keys():  # a coefficient: a number, or parameters
+        return [_constant(node)]
+    if node.is_Add:
+        result: list[Fraction] = []
+        for part in parts:
+            result += [Fraction(0)] * (len(part) - len(result))
+            for k, c in enumerate(part):
+                result[k] += c
+        return result
+    if node.is_Mul:
+        result = [Fraction(1)]
+        for part in parts:
+            result = _times(result, part)
+        return result
+    if node.is_Pow and node.exp.is_Integer and node.exp >= 0:
+        result, base, n = [Fraction(1)], parts[0], int(node.exp)
+        while n:  # by squaring
+            if n & 1:
+                result = _times(result, base)
+            n >>= 1
+            if n:
+                base = _times(base, base)
+        return result
+    raise ValueError(f"not a polynomial node: {node}")  # is_polynomial said it is
+
+
+def _constant(node: sympy.Basic) -> Fraction:
+    """A coefficient's value: exact for a rational; a parameter kept as a symbol (`--params
+    uniform`) gets a large pseudo-random integer of its own, like x, y and z."""
+    if node.is_Rational:
+        return Fraction(int(node.p), int(node.q))
+    if node.free_symbols:
+        node = node.xreplace({s: sympy.Integer(_symbol_value(s.name))
+                              for s in node.free_symbols})
+        if node.is_Rational:
+            return Fraction(int(node.p), int(node.q))
+    return Fraction(float(node))
+
+
+def _symbol_value(name: str) -> int:
+    """A fixed large integer per name (the same in every run and process)."""
+    value = 1_469_598_103_934_665_603
+    for char in name.encode():
+        value = ((value ^ char) * 1_099_511_628_211) % (1 << 61)
+    return value | 1
+
+
+def _times(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
+    result = [Fraction(0)] * (len(a) + len(b) - 1)
+    for i, x in enumerate(a):
+        if x:
+            for j, y in enumerate(b):
+                result[i + j] += x * y
+    return result
 
 
 RAY_PARAMETER = sympy.Symbol("s", real=True)

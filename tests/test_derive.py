@@ -276,3 +276,47 @@ def test_both_routes_to_the_ray_coefficients_agree(example, precision):
     for k, (g, w) in enumerate(zip(got, want, strict=True)):
         np.testing.assert_allclose(g, w, rtol=1e-9, atol=1e-9 * np.max(np.abs(w)),
                                    err_msg=f"{example}: c{k}")
+
+
+# --- the degree, without expanding (issue 44, point 9) ------------------------------------
+
+@pytest.mark.parametrize(("equation", "degree"), [
+    ("(x + 1)^2 - x^2", 1),  # cancellation: the tree says 2
+    ("(x^2 + y)^3 - x^6", 5),
+    ("x*y - y*x + z", 1),
+    ("(x^2+y^2+z^2+x*y+y*z+z*x+x+y+z+1)^15 - 2", 30),
+    ("x^2 - x^2 + y", 1),
+])
+def test_degree_is_exact_without_expanding(equation, degree, monkeypatch):
+    from implc.derive import polynomial_degree
+
+    expr = load_surface(equation=equation).expr
+    monkeypatch.setattr(sympy, "Poly", lambda *a, **k: pytest.fail("expanded with Poly"))
+    monkeypatch.setattr(sympy, "expand", lambda *a, **k: pytest.fail("expanded"))
+    assert polynomial_degree(expr) == degree
+
+
+def test_degree_agrees_with_sympy_on_every_example_and_corpus_row():
+    """Poly's total degree (which expands) on the bundled examples, with their parameters
+    as values and as symbols, and on the permissive corpus rows."""
+    from pathlib import Path
+
+    from implc import corpus
+    from implc.derive import polynomial_degree
+    from implc.surface import example_paths
+    from implc.symbols import POINT
+
+    exprs = []
+    for name in example_paths():
+        surface = load_surface(name)
+        exprs += [surface.expr, surface.symbolic_expr]
+    rows = corpus.load_rows(Path(__file__).parent / "data" / "corpus_permissive.tsv")
+    for row in rows:
+        try:
+            exprs.append(corpus.row_surface(row).expr)
+        except Exception:  # noqa: BLE001 - a row implc refuses has no degree to compare
+            continue
+    polynomials = [e for e in exprs if e.is_polynomial(*POINT)]
+    assert len(polynomials) > 60
+    for expr in polynomials:
+        assert polynomial_degree(expr) == sympy.Poly(expr, *POINT).total_degree(), expr
