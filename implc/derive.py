@@ -10,8 +10,10 @@ supplies the same named quantities; methods only name what they need.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from fractions import Fraction
 from functools import cached_property, lru_cache
+from typing import TypeVar
 
 import sympy
 
@@ -25,6 +27,7 @@ from .symbols import DIRECTION, POINT
 # sympy's differentiation and `cse` take time roughly proportional to it (about 20-50 us
 # a node here); the largest corpus row (a degree-18 torus knot) estimates ~340,000.
 DEFAULT_MAX_DERIVED = Limits().max_derived  # a surface's own is `Surface.limits`
+T = TypeVar("T")
 _CAP = 10**15  # estimates saturate here, so hostile input cannot build huge integers
 
 
@@ -38,7 +41,16 @@ def estimate_derived_size(expr: sympy.Expr) -> int:
     depth^3 here exactly as they do in sympy (`sin(sin(...(xyz)))`, 40 deep: ~640,000).
     """
     point = set(POINT)
-    memo: dict[sympy.Basic, tuple[int, int, int]] = {}
+    s, d1, d2 = fold_tree(expr, lambda node, parts: _node_estimate(node, parts, point))
+    return min(_CAP, s + 4 * d1 + 7 * d2)
+
+
+def fold_tree(expr: sympy.Expr,
+              combine: Callable[[sympy.Basic, list[T]], T]) -> T:
+    """`combine(node, [values of its arguments])` over the distinct sub-expressions of
+    `expr`, arguments first, iteratively (a deep tree does not reach Python's recursion
+    limit); the value of `expr`."""
+    memo: dict[sympy.Basic, T] = {}
     stack: list[tuple[sympy.Basic, bool]] = [(expr, False)]
     while stack:
         node, ready = stack.pop()
@@ -48,9 +60,8 @@ def estimate_derived_size(expr: sympy.Expr) -> int:
             stack.append((node, True))
             stack.extend((a, False) for a in node.args if a not in memo)
             continue
-        memo[node] = _node_estimate(node, [memo[a] for a in node.args], point)
-    s, d1, d2 = memo[expr]
-    return min(_CAP, s + 4 * d1 + 7 * d2)
+        memo[node] = combine(node, [memo[a] for a in node.args])
+    return memo[expr]
 
 
 def _node_estimate(node, parts: list[tuple[int, int, int]], point) -> tuple[int, int, int]:
@@ -240,21 +251,10 @@ DEGREE_POINTS = (
 
 
 def _degree_at(expr: sympy.Expr, point: tuple[int, int, int]) -> int:
-    """deg_t S(a t, b t, c t), by truncated-free exact arithmetic on lists of Fractions
-    (index k: the coefficient of t^k), over the distinct sub-expressions of S."""
+    """deg_t S(a t, b t, c t), by exact arithmetic on lists of Fractions (index k: the
+    coefficient of t^k) over the distinct sub-expressions of S."""
     values = dict(zip(POINT, point, strict=True))
-    memo: dict[sympy.Basic, list[Fraction]] = {}
-    stack: list[tuple[sympy.Basic, bool]] = [(expr, False)]
-    while stack:
-        node, ready = stack.pop()
-        if node in memo:
-            continue
-        if not ready and node.args:
-            stack.append((node, True))
-            stack.extend((a, False) for a in node.args if a not in memo)
-            continue
-        memo[node] = _t_poly(node, [memo[a] for a in node.args], values)
-    coefficients = memo[expr]
+    coefficients = fold_tree(expr, lambda node, parts: _t_poly(node, parts, values))
     return max((k for k, c in enumerate(coefficients) if c != 0), default=0)
 
 

@@ -32,6 +32,7 @@ AUTO_RAY_POLY_MAX_DEGREE = 12
 # degree-18 one, 0-5 on the gallery rows of degree 10-12, but thousands on Chmutov's
 # surfaces from degree 13 (coefficients up to 2^(n-1), where every method fails).
 EXACT_MAX_DEGREE = 20
+MAX_IMAGE = 8192  # the largest image side, in pixels (render, bench, the API)
 
 
 @dataclass(frozen=True)

@@ -79,12 +79,11 @@ def compile_record(surface: Framable, record: SurfaceRecord, target: str, method
                    params: str, constants: Mapping[str, Any],
                    notes: tuple[str, ...] = ()) -> Shader:
     """Compile `record` (the surface framed as the picture needs it) for `target`."""
-    from ..emit import check_shader_options, compile_shader
+    from ..emit import compile_shader
     from ..targets import TARGETS
 
     if target not in TARGETS:
         raise OptionError(f"unknown target '{target}'; choose from {', '.join(TARGETS)}")
-    check_shader_options(target, flavor, precision, prefix, emit, params)
     method, values = resolve_method(surface, method, constants)
     compiled = compile_shader(record, target, method, values, flavor, emit, prefix, precision,
                               params=params)

@@ -18,12 +18,13 @@ import sys
 from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TextIO
 
 from ..emit import render_template
 from ..errors import ImplcError
 from ..fileio import staged_directory, write_atomic
 from ..progress import Progress
+from .records import png_bytes
 
 SHEET_COLUMNS = 6  # cells per row of contact-sheet.png
 LABEL_HEIGHT = 14  # pixels under each thumbnail for its name
@@ -148,14 +149,6 @@ def _unique_stem(spec: str, taken: set[str]) -> str:
     return stem
 
 
-def _png_bytes(image: Any) -> bytes:
-    import io
-
-    buffer = io.BytesIO()
-    image.save(buffer, format="PNG")
-    return buffer.getvalue()
-
-
 def _write_sheet(path: Path, made: list[Made], size: int) -> None:
     """All thumbnails in one PNG, SHEET_COLUMNS a row, each named below; a failed
     surface's cell is dark red with its name."""
@@ -177,4 +170,4 @@ def _write_sheet(path: Path, made: list[Made], size: int) -> None:
             sheet.paste(Image.open(io.BytesIO(one.png)).convert("RGB"), (x, y))
         label = cell.name if len(cell.name) * 6 < size else cell.name[: size // 6 - 1] + "~"
         draw.text((x + 3, y + size + 1), label, fill=(220, 220, 225))
-    write_atomic(path, _png_bytes(sheet))
+    write_atomic(path, png_bytes(sheet))

@@ -149,13 +149,9 @@ class Rendering:
 
     def png(self) -> bytes:
         """The picture as PNG bytes."""
-        import io
-
         from PIL import Image
 
-        buffer = io.BytesIO()
-        Image.fromarray(self.image, "RGB").save(buffer, format="PNG")
-        return buffer.getvalue()
+        return png_bytes(Image.fromarray(self.image, "RGB"))
 
     def _repr_png_(self) -> bytes:
         return self.png()
@@ -163,3 +159,12 @@ class Rendering:
     def __repr__(self) -> str:
         return (f"<Rendering {self.surface.name!r} {self.width}x{self.height} "
                 f"{self.backend}/{self.method}: {100 * self.hit_fraction:.1f} % hit>")
+
+
+def png_bytes(image: Any) -> bytes:
+    """A PIL image as PNG bytes (a thumbnail, a contact sheet)."""
+    import io
+
+    buffer = io.BytesIO()
+    image.save(buffer, format="PNG")
+    return buffer.getvalue()

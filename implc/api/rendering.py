@@ -9,10 +9,9 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..errors import InputError, OptionError
+from ..options import MAX_IMAGE
 from .compiling import Framable, compile_record, resolve_method
 from .records import Rendering
-
-MAX_IMAGE = 8192  # the largest image side, in pixels
 
 
 def picture_size(size: int | None, width: int | None, height: int | None) -> tuple[int, int]:

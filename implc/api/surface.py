@@ -18,7 +18,6 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import OptionError
 from ..limits import Limits
-from ..options import Constants
 from ..scene import ViewOptions
 from .sympy_input import equation_text
 
@@ -31,7 +30,6 @@ if TYPE_CHECKING:
 
 Point = tuple[float, float, float]
 _AXES = {"x": 0, "y": 1, "z": 2}
-_CONSTANTS = tuple(Constants.__dataclass_fields__)
 
 
 class Surface:

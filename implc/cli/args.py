@@ -29,7 +29,6 @@ if TYPE_CHECKING:
     from ..api.surface import Surface
     from ..scene import ViewOptions
 
-MAX_IMAGE = 8192  # the largest image side, in pixels
 MAX_STEPS = 10_000_000  # the largest --max-steps
 
 

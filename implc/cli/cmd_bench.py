@@ -7,10 +7,10 @@ from pathlib import Path
 
 from ..errors import EXIT_OK, InputError
 from ..fileio import check_output_dir
-from ..options import METHOD_NAMES
+from ..options import MAX_IMAGE, METHOD_NAMES
 from ..render.run import BACKENDS
 from . import args as common
-from .args import MAX_IMAGE, UsageError
+from .args import UsageError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:

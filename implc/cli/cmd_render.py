@@ -9,10 +9,11 @@ from pathlib import Path
 
 from ..errors import EXIT_OK, InputError
 from ..fileio import check_output
+from ..options import MAX_IMAGE
 from ..render.run import BACKENDS, REFERENCE, REFERENCE_ABOUT
 from ..targets import TARGETS, backends_in, flavor_problem
 from . import args as common
-from .args import MAX_IMAGE, UsageError
+from .args import UsageError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
