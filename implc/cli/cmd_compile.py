@@ -97,7 +97,7 @@ def _compile_jsurf(args: argparse.Namespace, output: Path | None) -> int:
         write_atomic(output, text)
     else:
         sys.stdout.write(text)
-    for note in surface.framed()[1:]:
-        if note is not None:
-            print(note.message(), file=sys.stderr)
+    framing = surface.framed()[1]  # the framing to_jsurf wrote, said once it is written
+    if framing is not None:
+        print(framing.message(), file=sys.stderr)
     return EXIT_OK
