@@ -26,6 +26,7 @@ from .methods import Constants, Method, get_method
 from .optimize import Program
 from .pieces import build_programs, function_name
 from .resources import data_dir
+from .scaling import scale_exponent, scale_note, scaled
 from .scene import SHADING, View, light_directions, shading_for
 from .surface import Surface
 from .targets import TARGETS, flavor_problem, get_target, prefix_problem
@@ -181,6 +182,9 @@ def compile_shader(
         expr = surface.symbolic_expr.xreplace(
             {param_symbol(u.name): sympy.Symbol(u.ref, real=True) for u in uniforms})
         equation = surface.symbolic_equation
+    scale = scale_exponent(surface.expr)  # S's constants brought near 1 for float32
+    if scale:
+        expr, equation = scaled(expr, scale), f"{equation} ({scale_note(scale)})"
     # the same form as with --params constant
     max_derived = surface.limits.max_derived
     form = choose_form(meth, surface.expr, evaluation or constants.evaluation, max_derived)

@@ -23,6 +23,7 @@ from .conditioning import (
 from .derive import polynomial_degree
 from .options import EXACT_MAX_DEGREE, T_TOL
 from .raypoly import coefficient_program
+from .scaling import scale_exponent, scaled
 from .scene import View
 from .solver import ROBUST_NEWTON_BELOW
 from .surface import Surface
@@ -66,7 +67,12 @@ def float32_report(expr: sympy.Expr, view: View, degree: int,
                    point: bool = True) -> Float32Report:
     """The ray coefficients' measure where exact's Newton reads F from them (degree
     ROBUST_NEWTON_BELOW to EXACT_MAX_DEGREE), and S's at any degree unless `point` is
-    False (0.04-0.3 s: what a warning for exact alone does not need)."""
+    False (0.04-0.3 s: what a warning for exact alone does not need). Both measure S as the
+    shader has it: brought near 1 by a power of two where its constants are extreme."""
+    scale = scale_exponent(expr)  # measured as the shader computes it (implc/scaling.py)
+    expr = scaled(expr, scale)
+    if gradient is not None:
+        gradient = tuple(scaled(g, scale) for g in gradient)
     ray = (ray_conditioning(coefficient_program(expr, "float"), view)
            if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
     if not point:

@@ -18,6 +18,7 @@ from .raypoly import (
     estrin_derivative_ops,
     ray_quantity_ops,
 )
+from .scaling import scale_exponent, scale_note
 from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, walk_cost
 from .surface import Surface
 from .targets import where_precision
@@ -93,6 +94,9 @@ def _float32_lines(surface: Surface, degree: int,
         if report.ray_warns:
             lines.append("           warning: expect about that share of exact's pixels "
                          "with a wrong root in float32")
+    scale = scale_exponent(surface.expr)
+    if scale:
+        lines.append(f"           measured as the shader computes S: {scale_note(scale)}")
     if report.point_warns or report.ray_warns:
         lines.append("           in double it holds: --precision double with "
                      + where_precision("double"))

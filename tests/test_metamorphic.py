@@ -117,6 +117,63 @@ def test_scaled_surface_has_the_same_hits(backend, c, method):
     assert_masks_close(a, b, f"{c}·S, {method}, {backend}")
 
 
+
+# S times a constant far outside float32's comfort (issue 44, point 1): the compile brings
+# S's constants near 1 by a power of two (implc/scaling.py), so every method draws c*S as it
+# draws S; before that, 1e-25*S gave false hits and wrong roots with exact, taylor and
+# interval, and 1e20*S a flat disc (|grad S|^2 overflowed in the shading).
+EXTREME = {"1e25": sympy.Integer(10) ** 25, "1e-25": sympy.Integer(10) ** -25,
+           "1e20": sympy.Integer(10) ** 20}
+
+
+def assert_same_picture(a, b, what: str, strays: int = 0, t_tol: float = T_TOL,
+                        color_tol: float = COLOR_TOL) -> None:
+    """Masks close, t within `t_tol` but on at most `strays` pixels (taylor's thresholds
+    on |F| are absolute: c*S, brought near 1 by a power of two, is not S to the last bit),
+    and the colour close where t agrees."""
+    differ = a.hit != b.hit
+    off_edge = differ & ~(boundary(a.hit) | boundary(b.hit))
+    assert a.hit.sum() > 0.1 * a.hit.size, f"{what}: the surface is hardly in the picture"
+    assert not off_edge.any() and differ.sum() <= EDGE_PIXELS, f"{what}: masks differ"
+    both = a.hit & b.hit
+    agree = both & (np.abs(a.t - b.t) <= t_tol)
+    assert (both & ~agree).sum() <= strays, f"{what}: t differs on {(both & ~agree).sum()}"
+    assert np.abs(a.color - b.color)[agree].max() <= color_tol, f"{what}: colour differs"
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("c", list(EXTREME.values()), ids=list(EXTREME))
+@pytest.mark.parametrize("method", ["exact", "taylor", "hessian", "interval"])
+def test_extremely_scaled_surface_draws_the_same_picture(backend, c, method):
+    require_backend(backend)
+    s = load_surface("cross-cap")
+    a = frame(s, backend, method)
+    b = frame(Surface(s.name, c * s.expr, s.params, s.view), backend, method)
+    assert_same_picture(a, b, f"{c}·S, {method}, {backend}",
+                        strays=EDGE_PIXELS if method == "taylor" else 0)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize(("c", "t_tol", "color_tol"), [
+    (EXTREME["1e20"], T_TOL, COLOR_TOL),
+    # hessian's refinement stops on an absolute |F|, so 1e-20*S's t is 5e-4 off
+    (sympy.Integer(10) ** -20, 1e-3, 0.02)], ids=["1e20", "1e-20"])
+def test_shading_survives_any_gradient_scale(backend, c, t_tol, color_tol, monkeypatch):
+    """`shade` alone (the drop-ins' users call it with their own gradient): with the
+    compile's rescaling off, hessian still finds c*S's roots, and the normal must not be
+    lost to |g|^2 overflowing (1e20) or underflowing (1e-20) float32. Measured at 48^2:
+    colour within 1.2e-6 (1e20) and 0.017 (1e-20); a flat disc is 0.4 off."""
+    import implc.scaling
+
+    require_backend(backend)
+    monkeypatch.setattr(implc.scaling, "SCALE_BEYOND", 10**6)  # S compiled as written
+    s = load_surface("cross-cap")
+    a = frame(s, backend, "hessian")
+    b = frame(Surface(s.name, c * s.expr, s.params, s.view), backend, "hessian")
+    assert_same_picture(a, b, f"{c}·S unscaled, hessian, {backend}", t_tol=t_tol,
+                        color_tol=color_tol)
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("example", SURFACES)
 def test_rotated_and_translated_copies_look_the_same(backend, example):

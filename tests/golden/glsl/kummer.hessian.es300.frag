@@ -262,8 +262,10 @@ bool intersect(vec3 ro, vec3 rd, float t0, float t1, out float t) {
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 vec3 shade(vec3 g, vec3 rd) {
-    float len = length(g);
-    vec3 n = (len > 0.0 ? g/len : vec3(0.0, 0.0, 1.0));
+    // g over its largest component first, so that |g|^2 neither overflows nor underflows
+    // float32 wherever g itself is finite and not zero (S = 1e20 (x^2+y^2+z^2-1), S = 1e-25 ...)
+    float m = max(abs(g.x), max(abs(g.y), abs(g.z)));
+    vec3 n = (m > 0.0 ? normalize(g/m) : vec3(0.0, 0.0, 1.0));
     bool front = dot(n, rd) < 0.0;
     vec3 base = (front ? vec3(0.9, 0.62, 0.25) : vec3(0.3, 0.55, 0.9));
     n = (front ? n : -n);

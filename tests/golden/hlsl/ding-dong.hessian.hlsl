@@ -239,8 +239,10 @@ bool intersect(float3 ro, float3 rd, float t0, float t1, out float t) {
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 float3 shade(float3 g, float3 rd) {
-    float len = length(g);
-    float3 n = (len > 0.0 ? g/len : float3(0.0, 0.0, 1.0));
+    // g over its largest component first, so that |g|^2 neither overflows nor underflows
+    // float32 wherever g itself is finite and not zero (S = 1e20 (x^2+y^2+z^2-1), S = 1e-25 ...)
+    float m = max(abs(g.x), max(abs(g.y), abs(g.z)));
+    float3 n = (m > 0.0 ? normalize(g/m) : float3(0.0, 0.0, 1.0));
     bool front = dot(n, rd) < 0.0;
     float3 base = (front ? float3(0.9, 0.62, 0.25) : float3(0.3, 0.55, 0.9));
     n = (front ? n : -n);

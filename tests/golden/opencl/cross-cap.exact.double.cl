@@ -381,8 +381,10 @@ bool intersect(double3 ro, double3 rd, double t0, double t1, double* t) {
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 double3 shade(double3 g, double3 rd) {
-    double len = length(g);
-    double3 n = (len > 0.0 ? g/len : (double3)(0.0, 0.0, 1.0));
+    // g over its largest component first, so that |g|^2 neither overflows nor underflows
+    // float32 wherever g itself is finite and not zero (S = 1e20 (x^2+y^2+z^2-1), S = 1e-25 ...)
+    double m = max(fabs(g.x), max(fabs(g.y), fabs(g.z)));
+    double3 n = (m > 0.0 ? normalize(g/m) : (double3)(0.0, 0.0, 1.0));
     bool front = dot(n, rd) < 0.0;
     double3 base = (front ? (double3)(0.9, 0.62, 0.25) : (double3)(0.3, 0.55, 0.9));
     n = (front ? n : -n);

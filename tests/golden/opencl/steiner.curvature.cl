@@ -233,8 +233,10 @@ bool intersect(float3 ro, float3 rd, float t0, float t1, float* t) {
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 float3 shade(float3 g, float3 rd) {
-    float len = length(g);
-    float3 n = (len > 0.0f ? g/len : (float3)(0.0f, 0.0f, 1.0f));
+    // g over its largest component first, so that |g|^2 neither overflows nor underflows
+    // float32 wherever g itself is finite and not zero (S = 1e20 (x^2+y^2+z^2-1), S = 1e-25 ...)
+    float m = max(fabs(g.x), max(fabs(g.y), fabs(g.z)));
+    float3 n = (m > 0.0f ? normalize(g/m) : (float3)(0.0f, 0.0f, 1.0f));
     bool front = dot(n, rd) < 0.0f;
     float3 base = (front ? (float3)(0.9f, 0.62f, 0.25f) : (float3)(0.3f, 0.55f, 0.9f));
     n = (front ? n : -n);

@@ -389,8 +389,10 @@ fn intersect(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
 
 // Two-sided Blinn-Phong; the side is chosen by the sign of grad S . rd.
 fn shade(g: vec3<f32>, rd: vec3<f32>) -> vec3<f32> {
-    let len: f32 = length(g);
-    var n: vec3<f32> = select(vec3<f32>(0.0f, 0.0f, 1.0f), g/len, len > 0.0f);
+    // g over its largest component first, so that |g|^2 neither overflows nor underflows
+    // float32 wherever g itself is finite and not zero (S = 1e20 (x^2+y^2+z^2-1), S = 1e-25 ...)
+    let m: f32 = max(abs(g.x), max(abs(g.y), abs(g.z)));
+    var n: vec3<f32> = select(vec3<f32>(0.0f, 0.0f, 1.0f), normalize(g/m), m > 0.0f);
     let front: bool = dot(n, rd) < 0.0f;
     let base: vec3<f32> = select(vec3<f32>(0.3f, 0.55f, 0.9f), vec3<f32>(0.9f, 0.62f, 0.25f), front);
     n = select(-n, n, front);
