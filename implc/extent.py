@@ -36,6 +36,8 @@ SHRINKING = (0.5, 0.125, 0.03125)
 SEARCHED = GROWING[-1]
 MARGIN = 1.05  # the clip sphere is 5 % larger than the farthest sign change, plus a cell
 SPHERE_SAMPLES = 8192  # points on the clip sphere for `crosses_sphere`
+GROWTH = 1.25  # the clip sphere's step while the surface pierces it (`_clear_of_sphere`)
+GROWTH_STEPS = 3  # ... at most (1.95 times): pierced beyond that, the surface is unbounded
 
 
 def locate_surface(expr: sympy.Expr, center: Vec3 | None = None) -> Extent | None:
@@ -53,16 +55,65 @@ def _locate(expr: sympy.Expr, center: tuple[float, ...] | None) -> Extent | None
     for half in GROWING:
         points, spacing, touching = sign_changes(expr, origin, half)
         if len(points) and not touching:
-            return _bounded(expr, points, spacing, center)
+            return _clear_of_sphere(expr, _bounded(expr, points, spacing, center))
         if len(points) and first_found is None:
             first_found = half
-    if first_found is not None:  # unbounded: the first cube that holds a piece of it
-        return Extent(_vec3(origin), first_found, bounded=False)
+    if first_found is not None:  # unbounded: the first cube that holds a piece of it,
+        # or for a periodic surface one period each way of its centre
+        period = longest_period(expr)
+        return Extent(_vec3(origin), max(first_found, period), bounded=False, period=period)
     for half in SHRINKING:
         points, spacing, _ = sign_changes(expr, origin, half)
         if len(points):
             return _bounded(expr, points, spacing, center)
     return None
+
+
+def _clear_of_sphere(expr: sympy.Expr, extent: Extent) -> Extent:
+    """`extent` grown by GROWTH, at most GROWTH_STEPS times, until S keeps one sign on its
+    sphere, then by MARGIN: the grid misses a part thinner than its cells (the ends of
+    x^2/100 + y^2 + z^2/0.01 = 1, a hundred times longer than thick, framed at 8 instead of
+    10), the sphere's denser samples catch where it pierces. A surface that still pierces
+    the sphere after that is taken as unbounded (6x^2 - 2x^4 = y^2 z^2, whose arms thin
+    out along y and z): the part near the centre, as for the grid's own unbounded ones."""
+    radius = extent.radius
+    for _ in range(GROWTH_STEPS):
+        if not crosses_sphere(expr, extent.center, radius):
+            break
+        radius *= GROWTH
+    else:
+        if crosses_sphere(expr, extent.center, radius):
+            return Extent(extent.center, extent.radius, bounded=False)
+    if radius == extent.radius:
+        return extent
+    radius *= MARGIN
+    quantum = _quantum(radius)
+    return Extent(extent.center, round(math.ceil(radius / quantum - 1e-9) * quantum, 12),
+                  bounded=True)
+
+
+def longest_period(expr: sympy.Expr) -> float:
+    """The longest wavelength of S's waves, 0 when it has none: over every sin, cos or tan
+    of a linear form a.p + b, 2 pi / |a| (pi for tan). Framing shows an unbounded periodic
+    surface (the gyroid) a period each way of its centre rather than the one saddle the
+    first search cube holds; two significant digits."""
+    longest = 0.0
+    for node in expr.atoms(sympy.sin, sympy.cos, sympy.tan):
+        arg = node.args[0]
+        if not arg.free_symbols or not arg.free_symbols <= set(POINT):
+            continue
+        try:
+            poly = sympy.Poly(arg, *POINT)
+        except sympy.PolynomialError:
+            continue
+        if poly.total_degree() != 1:
+            continue
+        norm = math.sqrt(sum(float(poly.coeff_monomial(v)) ** 2 for v in POINT))
+        longest = max(longest, (math.pi if node.func is sympy.tan else 2 * math.pi) / norm)
+    if longest == 0.0:
+        return 0.0
+    quantum = _quantum(longest)
+    return round(math.ceil(longest / quantum - 1e-9) * quantum, 12)
 
 
 def _vec3(v) -> Vec3:

@@ -124,6 +124,7 @@ class Extent:
     center: Vec3
     radius: float
     bounded: bool
+    period: float = 0.0  # an unbounded periodic surface's longest wavelength (its radius)
 
 
 @dataclass(frozen=True)
@@ -154,8 +155,10 @@ class Framing:
             options.append("--eye")
         text = f"framed: {', '.join(parts)} (auto; {', '.join(options)} to set)"
         if self.extent is not None and not self.extent.bounded:
-            text += (f"; the surface reaches past |x|,|y|,|z| <= {self.searched:g} "
-                     "(unbounded?): this is the part near the centre")
+            text += ("; the surface seems unbounded (it reaches the edge of every region "
+                     "the search sampled): this is the part near the centre")
+            if self.extent.period:
+                text += f", a period ({self.extent.period:g}) each way"
         return text
 
 

@@ -304,3 +304,62 @@ def test_the_bundled_torus_is_not_clipped(tmp_path):
     assert proc.returncode == 0
     assert "clip sphere" not in proc.stderr and "warning" not in proc.stderr
     assert hit_percent(proc.stderr) > 10.0
+
+
+# --- issue 44, point 5: long or thin shapes, unbounded ones, the cut said always -----------
+
+def test_a_long_thin_ellipsoid_is_framed_whole():
+    """Its ends (x = +-10) are thinner than the grid's cells at the cube that holds it:
+    the grid alone framed it at radius 8 and cut them flat."""
+    extent = locate_surface(expr("x^2/100 + y^2 + z^2/0.01 = 1"))
+    assert extent is not None and extent.bounded
+    assert 10.0 < extent.radius <= 12.0
+
+
+def test_arms_that_thin_out_are_unbounded_and_never_held():
+    """6x^2 - 2x^4 = y^2 z^2 (SURFER's fantasy_helix) reaches every sphere along y and z;
+    the grid took it for bounded at radius 11, and a cut render said '--radius 11 holds
+    all of it'."""
+    equation = "6x^2 - 2x^4 = y^2 z^2"
+    extent = locate_surface(expr(equation))
+    assert extent is not None and not extent.bounded
+    cut = implc("render", "-e", equation, "--radius", "5", "-b", "reference", "--size", "32",
+                "-o", "/dev/null")
+    assert cut.returncode == 0, cut.stderr
+    assert "holds all of it" not in cut.stderr
+    assert "seems unbounded" in cut.stderr
+
+
+def test_a_cut_by_an_automatic_sphere_is_said(tmp_path, monkeypatch):
+    """The hits on the clip sphere (the aux buffer's t) are counted whoever chose the
+    sphere: with the sphere's growth turned off (the grid's framing alone, radius 8), the
+    ellipsoid's cut ends are said, where before only a --radius sphere was checked."""
+    import implc
+    import implc.extent
+
+    monkeypatch.setattr(implc.extent, "_clear_of_sphere", lambda expr, extent: extent)
+    implc.extent._locate.cache_clear()
+    try:
+        picture = implc.Surface("x^2/100 + y^2 + z^2/0.01 = 1").render(
+            backend="reference", size=96)
+    finally:
+        implc.extent._locate.cache_clear()
+    assert picture.view.clip_radius == 8.0
+    cut = [w for w in picture.warnings if "reaches the clip sphere" in w]
+    assert len(cut) == 1, picture.warnings
+    assert re.search(r"on \d+ pixels?: the picture is cut there", cut[0])
+    assert "--radius 16" in cut[0]
+
+
+# --- issue 44, point 18: periodic surfaces -------------------------------------------------
+
+def test_a_periodic_surface_is_framed_a_period_each_way():
+    gyroid = "sin(x)cos(y) + sin(y)cos(z) + sin(z)cos(x)"
+    extent = locate_surface(expr(gyroid))
+    assert extent is not None and not extent.bounded
+    assert extent.radius == pytest.approx(6.3) and extent.period == pytest.approx(6.3)
+    scaled = locate_surface(expr(gyroid.replace("(x)", "(3x)").replace("(y)", "(3y)")
+                                 .replace("(z)", "(3z)")))
+    assert scaled.radius == pytest.approx(2.1)  # 2 pi / 3
+    proc = implc("render", "-e", gyroid, "-b", "reference", "--size", "32", "-o", "/dev/null")
+    assert "a period (6.3) each way" in proc.stderr, proc.stderr
