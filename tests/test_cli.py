@@ -366,6 +366,20 @@ def test_a_files_params_take_constant_expressions_like_param(tmp_path):
     assert "with c = sqrt(39)/10" in shown.stdout, shown.stdout
 
 
+def test_a_parameter_cannot_name_another_and_says_why(tmp_path):
+    """A value defined from another parameter is refused (issue 44 point 11, a judgment):
+    each parameter is set on its own (a --param, a viewer's slider, a shader's uniform), so
+    c = 2*a would keep a's value of the moment while a moved. The message says so, with
+    the caret under the name, in a file and on the command line."""
+    path = tmp_path / "s.toml"
+    path.write_text('equation = "x^2 + y^2 + z^2 = c"\n[params]\na = 1\nc = "2*a"\n')
+    for proc in (implc("show", str(path)),
+                 implc("show", "-e", "x^2 + y^2 + z^2 = c", "--param", "a=1", "--param",
+                       "c=2*a")):
+        assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
+        assert "error: unknown name 'a'" in proc.stderr
+        assert "it cannot name another parameter" in proc.stderr
+
 def test_a_file_that_is_not_a_surface_is_named(tmp_path):
     """A shader, an image, a SURFER file named .toml: what it looks like and what implc
     reads, not a bare TOML error or the image's bytes echoed (issue 44)."""

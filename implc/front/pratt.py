@@ -326,7 +326,8 @@ class Parser:
         help_text = None
         if self.constant:
             help_text = ("a parameter's value is a number or a constant expression, like "
-                         "(1 + sqrt(5))/2")
+                         "(1 + sqrt(5))/2; it cannot name another parameter (each is set on "
+                         "its own: by --param, a viewer's slider, a shader's uniform)")
         elif free:
             given = " ".join(f"--param {name}=VALUE" for name in free)
             help_text = (f"give {'its value' if len(free) == 1 else 'their values'} with "
