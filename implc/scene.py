@@ -183,7 +183,7 @@ VIEW_OPTION_KEYS = ("radius", "center", "eye", "target", "up", "fov")  # the [vi
 
 def apply_view(
     view: View, options: ViewOptions, locate: Callable[[Vec3 | None], Extent | None],
-    aspect: float = 1.0, searched: float = 0.0,
+    searched: float = 0.0,
 ) -> tuple[View, Framing | None]:
     """`view` with the command line's `options` and what neither sets chosen by the rule
     above; `locate(center or None)` finds the surface, called only when the clip sphere
