@@ -38,7 +38,7 @@ def _sides(hit: np.ndarray) -> int:
 
 def test_the_issue_torus_at_600x700_is_whole():
     """The issue's command on GL: the torus (its file's eye, fov 35) touches neither side
-    (it had 700 + 700 hit pixels on the two side columns)."""
+    (it had 105 + 105 hit pixels on the two side columns)."""
     require_gl()
     result = _render(load_surface("torus"), "gl", 600, 700)
     assert _sides(result.hit) == 0
@@ -80,8 +80,8 @@ def test_an_auto_framed_surface_fills_the_shorter_side():
 @pytest.mark.parametrize("backend", GPU_BACKENDS)
 def test_every_backend_draws_the_portrait_reference(backend):
     """Each backend's own camera code (program templates, runners' uniforms) draws the
-    torus at 48 x 64 as the reference does; with the vertical fov kept on one side and
-    the shorter side's on the other, they shared under 80 % of their pixels."""
+    torus at 48 x 64 as the reference does (measured: identical hit masks, SSIM 1.0000;
+    with the vertical fov kept on one side only, 69 % of the pixels agreed at 64 x 96)."""
     require_backend(backend)
     surface = load_surface("torus")
     ref = _render(surface, "reference", W, H)
