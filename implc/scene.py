@@ -10,10 +10,8 @@ through the image-plane point at distance 1 along the view direction:
     dir   = normalize(forward + ndc_x * tan(fov/2) * (W/m) * right
                               + ndc_y * tan(fov/2) * (H/m) * up)
 with forward = normalize(target - eye), right = normalize(forward x up_hint),
-up = right x forward. The field of view `fov_y_deg` spans the picture's SHORTER side
-(the vertical one of a square or landscape picture, the horizontal one of a portrait
-picture), so the clip sphere that fits a square picture fits every picture (issue 44:
-a portrait frame kept the vertical field of view and cut the sides).
+up = right x forward. `fov_y_deg` spans the SHORTER side (vertical unless portrait), so
+what a square picture holds, every picture holds (issue 44: portraits lost the sides).
 """
 
 from __future__ import annotations
@@ -265,10 +263,9 @@ def point_text(v) -> str:
 # that is not parallel to it (right = forward x up would be zero: every ray is NaN), a
 # field of view inside (0, 180) degrees, a clip sphere of positive radius, and the clip
 # sphere must be inside the view at least partly. `view_problems` checks what needs no
-# image size: the plane of the eye, and the top and bottom of a square or landscape
-# picture (fov spans its height; a portrait picture sees more above and below, but a
-# [view] whose sphere lies wholly outside its own square picture is refused when it is
-# read); `frame_problem` adds the sides of a W x H frame, which widen with W/H.
+# image size: the plane of the eye, the top and bottom of a square picture (a portrait
+# one sees more there, but such a [view] is refused when read); `frame_problem` adds the
+# sides of a W x H frame, which widen with W/H.
 # The sphere tests are plane tests (conservative: a sphere that grazes a frustum corner
 # passes), so only a view that certainly shows nothing is refused.
 
