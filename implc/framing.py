@@ -31,11 +31,11 @@ VIEW_FLAGS = {"radius": "--radius", "center": "--center", "eye": "--eye",
 
 
 def frame(surface: Surface, options: ViewOptions | None = None,
-          aspect: float = 1.0) -> tuple[Surface, Framing | None]:
+          ) -> tuple[Surface, Framing | None]:
     """`surface` with its view completed, and what framing chose (None: nothing; its
-    `message()` is the line the command line prints). `aspect` is the picture's width /
-    height. A view that shows nothing raises: OptionError when options made it so, else
-    InputError pointing at the surface's [view]."""
+    `message()` is the line the command line prints). The same for every picture size
+    (the fov spans the shorter side). A view that shows nothing raises: OptionError when
+    options made it so, else InputError pointing at the surface's [view]."""
     options = options or ViewOptions()
     # refuse a too complex surface before sampling it
     check_derived_size(surface.expr, surface.limits.max_derived)
@@ -43,7 +43,7 @@ def frame(surface: Surface, options: ViewOptions | None = None,
     if "radius" not in surface.view.given | options.given():  # a sphere is to be found
         from .extent import SEARCHED as searched
     view, framing = apply_view(surface.view, options, lambda center: _locate(surface, center),
-                               aspect, searched)
+                               searched)
     problems = view_problems(view)
     if problems:
         flags = " ".join(VIEW_FLAGS[key] for key in sorted(options.given()))

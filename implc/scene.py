@@ -6,10 +6,12 @@ the numpy functions below, so a GPU image and the reference are directly compara
 
 Pixel (i, j), column i from the left and row j from the top, is the ray from `eye`
 through the image-plane point at distance 1 along the view direction:
-    ndc_x = 2 (i + 0.5) / W - 1,   ndc_y = 1 - 2 (j + 0.5) / H
-    dir   = normalize(forward + ndc_x * tan(fov_y/2) * (W/H) * right + ndc_y * tan(fov_y/2) * up)
+    ndc_x = 2 (i + 0.5) / W - 1,   ndc_y = 1 - 2 (j + 0.5) / H,   m = min(W, H)
+    dir   = normalize(forward + ndc_x * tan(fov/2) * (W/m) * right
+                              + ndc_y * tan(fov/2) * (H/m) * up)
 with forward = normalize(target - eye), right = normalize(forward x up_hint),
-up = right x forward.
+up = right x forward. `fov_y_deg` spans the SHORTER side (vertical unless portrait), so
+what a square picture holds, every picture holds (issue 44: portraits lost the sides).
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ class View:
     eye: Vec3 = (3.0, 2.0, 4.0)
     target: Vec3 = (0.0, 0.0, 0.0)
     up: Vec3 = (0.0, 1.0, 0.0)
-    fov_y_deg: float = 30.0
+    fov_y_deg: float = 30.0  # across the shorter side of the picture (see above)
     clip_center: Vec3 = (0.0, 0.0, 0.0)
     clip_radius: float = 1.5
     # front and back colours (RGB in [0, 1]); None: SHADING's (a .jsurf file sets them)
@@ -182,7 +184,7 @@ VIEW_OPTION_KEYS = ("radius", "center", "eye", "target", "up", "fov")  # the [vi
 
 def apply_view(
     view: View, options: ViewOptions, locate: Callable[[Vec3 | None], Extent | None],
-    aspect: float = 1.0, searched: float = 0.0,
+    searched: float = 0.0,
 ) -> tuple[View, Framing | None]:
     """`view` with the command line's `options` and what neither sets chosen by the rule
     above; `locate(center or None)` finds the surface, called only when the clip sphere
@@ -213,7 +215,7 @@ def apply_view(
 
         aim = np.asarray(target, dtype=np.float64)
         off_centre = float(np.linalg.norm(np.asarray(center) - aim))
-        point = aim + (off_centre + fit_distance(radius, fov, aspect)) * frame_direction(up)
+        point = aim + (off_centre + fit_distance(radius, fov)) * frame_direction(up)
         eye = (float(point[0]), float(point[1]), float(point[2]))
     result = View(eye=eye, target=target, up=up, fov_y_deg=fov, clip_center=center,
                   clip_radius=radius, front=view.front, back=view.back, given=view.given)
@@ -239,13 +241,18 @@ def frame_direction(up: Vec3) -> np.ndarray:
     return rotation @ d
 
 
-def fit_distance(radius: float, fov_y_deg: float, aspect: float = 1.0) -> float:
+def fit_distance(radius: float, fov_y_deg: float) -> float:
     """How far from its centre a sphere of `radius` fills FRAME_FILL of the shorter side
-    of a picture with this vertical field of view and width / height."""
+    of a picture with this field of view (which spans that side: any aspect ratio)."""
     half = math.radians(fov_y_deg) / 2.0
-    if aspect < 1.0:  # taller than wide: the horizontal field of view is the smaller
-        half = math.atan(math.tan(half) * aspect)
     return radius / math.sin(math.atan(FRAME_FILL * math.tan(half)))
+
+
+def frame_spans(width: float, height: float) -> tuple[float, float]:
+    """(horizontal, vertical) half extents of a `width` x `height` picture on the image
+    plane, in units of tan(fov/2): the shorter side spans 1 (W/H and 1 when landscape)."""
+    short = min(width, height)
+    return width / short, height / short
 
 
 def point_text(v) -> str:
@@ -257,10 +264,11 @@ def point_text(v) -> str:
 # A view that cannot show anything is refused with a reason and a fix rather than
 # rendered as a blank picture: the camera needs a direction (eye != target), an up hint
 # that is not parallel to it (right = forward x up would be zero: every ray is NaN), a
-# vertical field of view inside (0, 180) degrees, a clip sphere of positive radius, and
-# the clip sphere must be inside the view at least partly. `view_problems` checks what
-# holds for every image size (the sphere against the vertical field of view and the
-# plane of the eye); `frame_problem` adds the horizontal field of view of a W x H frame.
+# field of view inside (0, 180) degrees, a clip sphere of positive radius, and the clip
+# sphere must be inside the view at least partly. `view_problems` checks what needs no
+# image size: the plane of the eye, the top and bottom of a square picture (a portrait
+# one sees more there, but such a [view] is refused when read); `frame_problem` adds the
+# sides of a W x H frame, which widen with W/H.
 # The sphere tests are plane tests (conservative: a sphere that grazes a frustum corner
 # passes), so only a view that certainly shows nothing is refused.
 
@@ -276,7 +284,7 @@ def view_problems(view: View) -> list[tuple[str, str]]:
         return [("view", "every [view] value must be a finite number (no nan or inf)")]
     if not 0.0 < view.fov_y_deg < 180.0:
         problems.append(("fov", f"fov = {view.fov_y_deg:g} is outside (0, 180) degrees; "
-                                "a vertical field of view like fov = 30 shows the picture"))
+                                "a field of view like fov = 30 shows the picture"))
     if not view.clip_radius > 0.0:
         problems.append(("radius", f"radius = {view.clip_radius:g}: the clip sphere needs a "
                                    "positive radius, e.g. radius = 1.5"))
@@ -323,7 +331,7 @@ def _sphere_outside(view: View, aspect: float | None) -> str | None:
     """Where the clip sphere lies wholly outside the view (behind the eye, beyond one
     side of the frustum), as a message with a fix; None when part of it may be seen.
 
-    aspect None: only what holds at every aspect ratio (behind, above, below)."""
+    aspect (width / height) None: behind, and above or below a square picture."""
     forward, right, up = camera_axes(view)
     offset = _sub(_floats(view.clip_center), _floats(view.eye))
     radius = view.clip_radius
@@ -332,12 +340,14 @@ def _sphere_outside(view: View, aspect: float | None) -> str | None:
         """-sin(angle) forward +- cos(angle) side: the outward normal of a frustum plane."""
         return _add(_scale(-math.sin(angle), forward), _scale(sign * math.cos(angle), side))
 
-    half_v = math.radians(view.fov_y_deg) / 2.0
+    tan_half = math.tan(math.radians(view.fov_y_deg) / 2.0)
+    span_x, span_y = frame_spans(1.0 if aspect is None else aspect, 1.0)
+    half_v = math.atan(tan_half * span_y)
     planes = [("behind the camera", _scale(-1.0, forward)),
               ("above the picture", tilt(half_v, up, 1.0)),
               ("below the picture", tilt(half_v, up, -1.0))]
     if aspect is not None:
-        half_h = math.atan(math.tan(half_v) * aspect)
+        half_h = math.atan(tan_half * span_x)
         planes += [("right of the picture", tilt(half_h, right, 1.0)),
                    ("left of the picture", tilt(half_h, right, -1.0))]
     for where, normal in planes:
@@ -434,12 +444,13 @@ def pixel_rays(view: View, width: int, height: int) -> tuple[np.ndarray, np.ndar
 
     forward, right, up = camera_basis(view)
     tan_half = math.tan(math.radians(view.fov_y_deg) / 2.0)
+    span_x, span_y = frame_spans(width, height)
     i = np.arange(width, dtype=np.float64)
     j = np.arange(height, dtype=np.float64)
     ndc_x = 2.0 * (i + 0.5) / width - 1.0
     ndc_y = 1.0 - 2.0 * (j + 0.5) / height
-    sx = (ndc_x * tan_half * width / height)[None, :, None]
-    sy = (ndc_y * tan_half)[:, None, None]
+    sx = (ndc_x * tan_half * span_x)[None, :, None]
+    sy = (ndc_y * tan_half * span_y)[:, None, None]
     dirs = normalize(forward[None, None, :] + sx * right[None, None, :] + sy * up[None, None, :])
     origins = np.broadcast_to(np.asarray(view.eye, dtype=np.float64), dirs.shape).copy()
     return origins, dirs

@@ -178,15 +178,14 @@ def box_t(view, width, height) -> np.ndarray:
     return np.where((far >= near) & (far > 0), np.maximum(near, 0), np.inf)
 
 
-def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
-    module = three_module()
-    surface = load_surface("torus")
+def three_page(tmp_path, surface, width: int, height: int) -> Path:
+    """The three.js test page showing the torus library at `width` x `height`."""
     view = surface.view
     prefix = "torus_"
     library = emit(surface, "glsl", "hessian", hessian(), emit_form="library", prefix=prefix,
                    params="uniform")
     data = {
-        "width": THREE_SIZE, "height": THREE_SIZE,
+        "width": width, "height": height,
         "view": {"eye": view.eye, "target": view.target, "up": view.up, "fov_y": view.fov_y_deg,
                  "clip_center": view.clip_center, "clip_radius": view.clip_radius,
                  "background": SHADING.background},
@@ -199,7 +198,14 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
     }
     page_path = tmp_path / "three.html"
     page_path.write_text(render_template("browser/three.html.j2", data=data,
-                                         three_url=module.as_uri()))
+                                         three_url=three_module().as_uri()))
+    return page_path
+
+
+def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
+    surface = load_surface("torus")
+    view = surface.view
+    page_path = three_page(tmp_path, surface, THREE_SIZE, THREE_SIZE)
     shots = {}
     with open_page(browser, file_url(page_path)) as (page, log):
         page.wait_for_function("window.implcThree && (implcThree.ready || implcThree.error)")
@@ -246,3 +252,25 @@ def test_three_js_surface_and_mesh_hide_each_other(browser, tmp_path):
     assert mesh_front.sum() > 100 and surface_front.sum() > 100, "the scene lost its overlap"
     assert right >= 0.99 * overlap.sum()
     assert score_surface >= SSIM_SAME and score_both >= SSIM_SAME
+
+
+def test_three_js_portrait_canvas_keeps_implcs_camera(browser, tmp_path):
+    """Issue 44: implc's fov spans the shorter side, three's is vertical: on a portrait
+    canvas the page gives three the vertical fov that makes the same picture (with v.fov_y
+    passed as it is, the torus came out larger, its sides cut)."""
+    surface = load_surface("torus")
+    width, height = 120, 160
+    with open_page(browser, file_url(three_page(tmp_path, surface, width, height))) as (page, log):
+        page.wait_for_function("window.implcThree && (implcThree.ready || implcThree.error)")
+        assert page.evaluate("implcThree.error") == ""
+        assert page.evaluate("implcThree.show(true, false)") == ""
+        shot = screenshot(page.locator("#canvas"), "three-portrait")
+        assert log.problems() == []
+    reference = render(surface, "reference", "hessian", hessian(), width, height)
+    expected = to_8bit(np.where(reference.hit[..., None], reference.color,
+                                np.asarray(SHADING.background)))
+    score = ssim(shot, expected)
+    print(f"three at {width}x{height} vs reference: SSIM {score:.5f}")
+    assert score >= SSIM_SAME
+    background = background_mask(shot, SHADING.background)
+    assert background[:, 0].all() and background[:, -1].all()

@@ -574,17 +574,24 @@ def test_surface_file_faults_are_located(tmp_path, content, expected):
 
 
 def test_a_frame_that_misses_the_clip_sphere_is_refused(tmp_path):
-    """Visible in a square frame's vertical field of view, but a 16 x 512 strip is too
-    narrow: the horizontal test needs the frame size (render time)."""
+    """Left of a square frame (the fov spans the shorter side: a 16 x 512 strip sees no
+    more at the sides than a square), but a 64 x 16 frame's sides are wider and show it:
+    the horizontal test needs the frame size (render time). (Issue 44 changed the input,
+    not the assertions: with the vertical fov kept, target [3, 0, 0] was in a square frame
+    and out of the 16 x 512 strip; now every frame holds what the square one does.)"""
     surface = tmp_path / "s.toml"
     surface.write_text('equation = "x^2 + y^2 + z^2 - 1"\n[view]\neye = [0, 0, 8]\n'
-                       'target = [3, 0, 0]\nradius = 1\n')
+                       'target = [5, 0, 0]\nradius = 1\n')
     proc = implc("render", str(surface), "--width", "16", "--height", "512",
                  "-o", str(tmp_path / "a.png"))
     assert proc.returncode == 1
     line = _one_error_line(proc)
     assert "entirely left of the picture" in line and "(16x512)" in line
     assert not (tmp_path / "a.png").exists()
+    wide = implc("render", str(surface), "--width", "64", "--height", "16",
+                 "-o", str(tmp_path / "b.png"))
+    assert wide.returncode == 0, wide.stderr
+    assert re.search(r"; [1-9][0-9.]* % of pixels hit", wide.stderr), wide.stderr
 
 
 def test_validate_missing_file_is_bad_input(tmp_path):

@@ -287,7 +287,7 @@ def test_mouse_turns_pans_zooms_and_resets(browser, tmp_path):
     assert np.array_equal(reset, first)
 
 
-def _gl_frame(surface, camera: View) -> np.ndarray:
+def _gl_frame(surface, camera: View, width: int = SMALL, height: int = SMALL) -> np.ndarray:
     """The GL render of the surface's program (lights fixed by its [view], like the
     page's) seen from `camera` through the program's uniforms."""
     from conftest import require_gl
@@ -298,11 +298,34 @@ def _gl_frame(surface, camera: View) -> np.ndarray:
     require_gl()
     fragment = emit(surface, "glsl", METHOD, method_constants(), flavor="330")
     vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
-    runner = GlRunner(fragment, vertex, camera, SMALL, SMALL)
+    runner = GlRunner(fragment, vertex, camera, width, height)
     try:
         return runner.frame().color
     finally:
         runner.release()
+
+
+def test_a_portrait_stage_keeps_the_sides(browser, tmp_path):
+    """Issue 44: `implc view torus` in a 900 x 700 window (a 600 x 700 stage beside the
+    panel) cut the torus left and right: the page's camera kept the vertical field of
+    view. The fov spans the stage's shorter side: the frame is the GL render at the
+    canvas's size, and the torus touches neither side."""
+    page_path = write_page(tmp_path, "torus")
+    with open_page(browser, file_url(page_path), width=900, height=700) as (page, log):
+        wait_idle(page)
+        frame = screenshot(page.locator("#gl-canvas"), "view-portrait")
+        width, height = page.evaluate("[document.getElementById('gl-canvas').width, "
+                                      "document.getElementById('gl-canvas').height]")
+        assert log.problems() == []
+    assert height > width and frame.shape == (height, width, 3)
+    surface = load_surface("torus")
+    expected = to_8bit(_gl_frame(surface, surface.view, width, height))
+    score = ssim(frame, expected)
+    print(f"torus in a {width}x{height} stage vs GL render: SSIM {score:.5f}")
+    assert score >= SSIM_SAME
+    background = background_mask(frame, BACKGROUND)
+    assert background[:, 0].all() and background[:, -1].all()
+    assert np.mean(background == background_mask(expected, BACKGROUND)) >= MASK_AGREEMENT
 
 
 def test_touch_orbits_and_pinch_zooms(browser, tmp_path):

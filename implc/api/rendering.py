@@ -56,7 +56,7 @@ def render_surface(surface: Framable, size: int | None = 512, *, width: int | No
 
     w, h = picture_size(size if width is None and height is None else None, width, height)
     backend = choose_backend(backend, precision)
-    record, framing = surface.framed(w / h)
+    record, framing = surface.framed()
     notes: tuple[str, ...] = (framing.message(),) if framing is not None else ()
     check_frame(record, w, h)
     start = time.perf_counter()

@@ -170,16 +170,16 @@ class Surface:
         return self._make(self._spec, self._equation, self._params, self._limits, options,
                           self._name)
 
-    def framed(self, aspect: float = 1.0) -> tuple[SurfaceRecord, Framing | None]:
-        """The record with its view completed for a picture of width / height `aspect`,
-        and what framing chose (None: nothing was left to choose)."""
-        cache: dict[float, tuple[SurfaceRecord, Framing | None]] = \
-            self.__dict__.setdefault("_framed", {})
-        if aspect not in cache:
-            from ..framing import frame
+    def framed(self) -> tuple[SurfaceRecord, Framing | None]:
+        """The record with its view completed (for every picture size: the fov spans the
+        shorter side), and what framing chose (None: nothing was left to choose)."""
+        return self._framing
 
-            cache[aspect] = frame(self.record, self._options, aspect)
-        return cache[aspect]
+    @cached_property
+    def _framing(self) -> tuple[SurfaceRecord, Framing | None]:
+        from ..framing import frame
+
+        return frame(self.record, self._options)
 
     @property
     def view_options(self) -> ViewOptions:

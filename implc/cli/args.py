@@ -119,7 +119,8 @@ def view_args(p: argparse.ArgumentParser) -> None:
                         "up, or the file's `up`); --up z for equations written z-up; -x, "
                         "-y, -z turn it over")
     v.add_argument("--fov", type=fov_arg, metavar="DEG",
-                   help="vertical field of view in degrees (default: the file's, else 30)")
+                   help="field of view across the picture's shorter side, in degrees "
+                        "(default: the file's, else 30)")
     p.set_defaults(view_options=True)
 
 

@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.output, (".png", ".exr"), what="a render",
                  sidecars=(".json",))
     surface = common.surface(args)
-    record, _ = surface.framed(width / height)
+    record, _ = surface.framed()
     method = args.method or surface.default_method
     common.warn_ignored(args, method, reference=backend == REFERENCE)
     check_frame(record, width, height)

@@ -11,7 +11,7 @@ A surface file:
     eye = [3.0, 2.0, 4.0]
     target = [0.0, 0.0, 0.0]
     up = [0.0, 1.0, 0.0]
-    fov = 30.0          # vertical, degrees
+    fov = 30.0          # degrees, across the picture's shorter side
 
 Errors point into the file: an equation inside a TOML string is located at its own
 line and column, so a caret lands under the offending character of the file.

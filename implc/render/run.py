@@ -176,8 +176,9 @@ def metadata(
         "backend": backend,
         "timing": {k: round(v, 6) for k, v in sorted(result.timing.items())},
         "pixel_rule": "pixel (i, j), column i from the left, row j from the top: "
-                      "ndc = (2(i+0.5)/W - 1, 1 - 2(j+0.5)/H); dir = normalize(forward + "
-                      "ndc.x*tan(fov_y/2)*W/H*right + ndc.y*tan(fov_y/2)*up); "
+                      "ndc = (2(i+0.5)/W - 1, 1 - 2(j+0.5)/H), m = min(W, H); "
+                      "dir = normalize(forward + ndc.x*tan(fov_y/2)*W/m*right + "
+                      "ndc.y*tan(fov_y/2)*H/m*up) (fov_y spans the shorter side); "
                       "right = normalize(forward x up), up = right x forward; "
                       "t (EXR Z) is the distance from eye along dir",
     }

@@ -30,9 +30,10 @@ def _uniforms(view: View, width: int, height: int,
               params: Sequence[ParamUniform] = (), values: Mapping[str, float] | None = None,
               ) -> bytes:
     """The `Uniforms` block, laid out as the WGSL uniform address space requires
-    (vec3<f32> aligned to 16 bytes): offsets 0 resolution, 8 fov_y, 12 clip_radius,
-    16 eye, 32 target, 48 up, 64 clip_center (80 bytes); with `--params uniform` one f32
-    per parameter from offset 76 (`ParamUniform.offset`), rounded up to 16 bytes."""
+    (vec3<f32> aligned to 16 bytes): offsets 0 resolution, 8 fov_y (across the shorter
+    side), 12 clip_radius, 16 eye, 32 target, 48 up, 64 clip_center (80 bytes); with
+    `--params uniform` one f32 per parameter from offset 76 (`ParamUniform.offset`),
+    rounded up to 16 bytes."""
     end = max([UNIFORM_FLOATS * 4] + [p.offset + 4 for p in params])
     data = np.zeros(-(-end // 16) * 4, np.float32)
     data[0:2] = (width, height)

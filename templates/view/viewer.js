@@ -316,7 +316,9 @@
   function pan(dx, dy) {
     const b = basis();
     const distance = len(sub(camera.eye, camera.target));
-    const perPx = 2 * distance * Math.tan(camera.fov_y * Math.PI / 360) / Math.max(activeCanvas().clientHeight, 1);
+    const canvas = activeCanvas();  // fov_y spans the canvas's shorter side
+    const perPx = 2 * distance * Math.tan(camera.fov_y * Math.PI / 360) /
+      Math.max(Math.min(canvas.clientWidth, canvas.clientHeight), 1);
     const move = add(mul(b.right, -dx * perPx), mul(b.up, dy * perPx));
     camera.eye = add(camera.eye, move);
     camera.target = add(camera.target, move);

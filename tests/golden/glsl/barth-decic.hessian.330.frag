@@ -4,13 +4,15 @@
 // Equation: 8*(-6.854101966249687*x^2 + z^2)*(x^2 - 6.854101966249687*y^2)*(y^2 - 6.854101966249687*z^2)*(x^4 - 2*x^2*y^2 - 2*x^2*z^2 + y^4 - 2*y^2*z^2 + z^4) + 11.090169943749475*(x^2 + y^2 + z^2 - 1)^2*(x^2 + y^2 + z^2 - 0.381966011250105)^2 = 0
 // Method: hessian (Eq. 4: paper)
 
-// Camera: pixel (i, j) looks along normalize(forward + ndc.x*tan(fov/2)*aspect*right
-// + ndc.y*tan(fov/2)*up), ndc = 2*gl_FragCoord.xy/u_resolution - 1 (see README).
+// Camera: pixel (i, j) looks along normalize(forward + ndc.x*tan(fov/2)*span.x*right
+// + ndc.y*tan(fov/2)*span.y*up), ndc = 2*gl_FragCoord.xy/u_resolution - 1,
+// span = u_resolution/min(u_resolution.x, u_resolution.y): the fov spans the shorter
+// side (see README).
 uniform vec2 u_resolution;   // framebuffer size in pixels
 uniform vec3 u_eye;          // camera position
 uniform vec3 u_target;       // point the camera looks at
 uniform vec3 u_up;           // up hint
-uniform float u_fov_y;       // vertical field of view, degrees
+uniform float u_fov_y;       // field of view across the shorter side, degrees
 uniform vec3 u_clip_center;  // clip sphere: the surface is searched inside it only
 uniform float u_clip_radius;
 
@@ -384,7 +386,8 @@ void main() {
     vec3 right = normalize(cross(forward, up_hint));
     vec3 up = cross(right, forward);
     float th = tan(radians(fov_y)*0.5);
-    vec3 rd = normalize(forward + ndc.x*th*(resolution.x/resolution.y)*right + ndc.y*th*up);
+    vec2 span = resolution/min(resolution.x, resolution.y);  // the shorter side spans 1
+    vec3 rd = normalize(forward + ndc.x*th*span.x*right + ndc.y*th*span.y*up);
 
     vec3 color = vec3(0.08, 0.08, 0.1);
     vec4 aux = vec4(0.0);

@@ -372,7 +372,8 @@ void mainImage(out vec4 fragColor, in vec2 fragCoord) {
     vec3 right = normalize(cross(forward, up_hint));
     vec3 up = cross(right, forward);
     float th = tan(radians(fov_y)*0.5);
-    vec3 rd = normalize(forward + ndc.x*th*(resolution.x/resolution.y)*right + ndc.y*th*up);
+    vec2 span = resolution/min(resolution.x, resolution.y);  // the shorter side spans 1
+    vec3 rd = normalize(forward + ndc.x*th*span.x*right + ndc.y*th*span.y*up);
 
     vec3 color = vec3(0.08, 0.08, 0.1);
     vec4 aux = vec4(0.0);

@@ -5,15 +5,16 @@
 
 // Pixel shader (Shader Model 5 and later, Direct3D conventions): entry point main, over a
 // full-screen triangle. SV_Position has its origin at the top-left pixel, rows growing
-// downwards, so pixel (i, j) looks along normalize(forward + ndc.x*tan(fov/2)*aspect*right
-// + ndc.y*tan(fov/2)*up) with ndc = (2*x/w - 1, 1 - 2*y/h) (see README).
+// downwards, so pixel (i, j) looks along normalize(forward + ndc.x*tan(fov/2)*span.x*right
+// + ndc.y*tan(fov/2)*span.y*up) with ndc = (2*x/w - 1, 1 - 2*y/h) and
+// span = (w, h)/min(w, h): the fov spans the shorter side (see README).
 // The uniforms are the $Globals constant buffer (set them by name, or move them into
 // your engine's own cbuffer).
 uniform float2 u_resolution;   // render target size in pixels
 uniform float3 u_eye;          // camera position
 uniform float3 u_target;       // point the camera looks at
 uniform float3 u_up;           // up hint
-uniform float u_fov_y;         // vertical field of view, degrees
+uniform float u_fov_y;         // field of view across the shorter side, degrees
 uniform float3 u_clip_center;  // clip sphere: the surface is searched inside it only
 uniform float u_clip_radius;
 
@@ -291,7 +292,8 @@ PixelOut main(float4 position : SV_Position) {
     float3 right = normalize(cross(forward, u_up));
     float3 up = cross(right, forward);
     float th = tan(radians(u_fov_y)*0.5);
-    float3 rd = normalize(forward + ndc.x*th*(resolution.x/resolution.y)*right + ndc.y*th*up);
+    float2 span = resolution/min(resolution.x, resolution.y);  // the shorter side spans 1
+    float3 rd = normalize(forward + ndc.x*th*span.x*right + ndc.y*th*span.y*up);
 
     float3 color = float3(0.08, 0.08, 0.1);
     float4 aux = float4(0.0, 0.0, 0.0, 0.0);

@@ -9,14 +9,15 @@
 //   __kernel void render(float3 u_eye, float3 u_target, float3 u_up, float u_fov_y,
 //                        int u_width, int u_height, float3 u_clip_center, float u_clip_radius,
 //                        __global float4* color, __global float4* aux)
-// u_eye: camera position; u_target: point it looks at; u_up: up hint; u_fov_y: vertical
-// field of view in degrees; u_width x u_height: image size in pixels; u_clip_center,
-// u_clip_radius: the sphere the surface is searched in. Pixel (i, j) = (get_global_id(0),
-// get_global_id(1)), row j from the TOP, writes element j*u_width + i of
+// u_eye: camera position; u_target: point it looks at; u_up: up hint; u_fov_y: field of
+// view across the shorter side, degrees; u_width x u_height: image size in pixels;
+// u_clip_center, u_clip_radius: the sphere the surface is searched in. Pixel (i, j) =
+// (get_global_id(0), get_global_id(1)), row j from the TOP, writes element j*u_width + i of
 //   color: (shaded r, g, b, 1)
 //   aux:   (hit 0/1, t from the eye, march steps, |S| at the hit)
-// Its ray is normalize(forward + ndc.x*tan(fov/2)*aspect*right + ndc.y*tan(fov/2)*up),
-// ndc = (2(i + 0.5)/width - 1, 1 - 2(j + 0.5)/height) (see README).
+// Its ray is normalize(forward + ndc.x*tan(fov/2)*span_x*right + ndc.y*tan(fov/2)*span_y*up),
+// ndc = (2(i + 0.5)/width - 1, 1 - 2(j + 0.5)/height), (span_x, span_y) =
+// (width, height)/min(width, height): the fov spans the shorter side (see README).
 
 // Method constants (implc compile options).
 __constant float IV_ULP = 2.384185791015625e-07f;
@@ -473,7 +474,9 @@ __kernel void render(float3 u_eye, float3 u_target, float3 u_up, float u_fov_y,
     float3 right = normalize(cross(forward, up_hint));
     float3 up = cross(right, forward);
     float th = tan(radians(fov_y)*0.5f);
-    float3 rd = normalize(forward + ndc_x*th*(width/height)*right + ndc_y*th*up);
+    float short_side = fmin(width, height);  // the shorter side spans 1
+    float3 rd = normalize(forward + ndc_x*th*(width/short_side)*right
+                            + ndc_y*th*(height/short_side)*up);
 
     float3 shaded = (float3)(0.08f, 0.08f, 0.1f);
     float4 info = (float4)(0.0f);

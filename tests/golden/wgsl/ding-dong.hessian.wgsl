@@ -6,7 +6,8 @@
 
 // Compute shader: one invocation per pixel, workgroups of 8 x 8; dispatch
 // (ceil(W/8), ceil(H/8), 1). Pixel (i, j) = global_invocation_id.xy, row j from the top:
-// ndc = (2(i + 0.5)/W - 1, 1 - 2(j + 0.5)/H) (see README "Camera and pixels").
+// ndc = (2(i + 0.5)/W - 1, 1 - 2(j + 0.5)/H); u_fov_y spans the shorter side (see README
+// "Camera and pixels").
 //
 // Bind group 0 (see README "Drop-in contract (WGSL)"):
 //   @binding(0) uniform Uniforms (80 bytes; byte offsets below)
@@ -15,7 +16,7 @@
 //               (hit 0/1, t from the eye, march steps, |S| at the hit)
 struct Uniforms {
     u_resolution: vec2<f32>,   // offset  0: image size in pixels (W, H)
-    u_fov_y: f32,              // offset  8: vertical field of view, degrees
+    u_fov_y: f32,              // offset  8: field of view across the shorter side, degrees
     u_clip_radius: f32,        // offset 12: clip sphere radius
     u_eye: vec3<f32>,          // offset 16: camera position
     u_target: vec3<f32>,       // offset 32: point the camera looks at
@@ -266,7 +267,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let right = normalize(cross(forward, up_hint));
     let up = cross(right, forward);
     let th = tan(radians(fov_y)*0.5f);
-    let rd = normalize(forward + ndc.x*th*(resolution.x/resolution.y)*right + ndc.y*th*up);
+    let span = resolution/min(resolution.x, resolution.y);  // the shorter side spans 1
+    let rd = normalize(forward + ndc.x*th*span.x*right + ndc.y*th*span.y*up);
 
     var color = vec3<f32>(0.08f, 0.08f, 0.1f);
     var aux = vec4<f32>(0.0f);
