@@ -50,6 +50,10 @@ WARN_SHARE = 0.01
 # 3.5 % (3.2 %), T_18 20 % (16 %), T_11 and T_10 0 (24 and 8 pixels); corpus rows 163, 244,
 # 285, Barth's decic and sums of powers to degree 20: 0; row 247 0.05 % (7 pixels).
 RAYS = 128
+# A coefficient program longer than this (the corpus's expanded rows: row 246's degree-18
+# knot has 4,036 steps; Chmutov's T_20 790) is measured on RAYS/2 a side: the measure costs
+# rays x steps, and at 128^2 it took 0.5 s of that knot's 3 s compile (issue 44)
+LONG_PROGRAM = 2000
 SAMPLES = 256
 RAY_WARN_SHARE = 1e-3
 
@@ -108,13 +112,16 @@ def float32_conditioning(expr: sympy.Expr,
                         float(np.percentile(moved, 90)), float(np.mean(moved > T_TOL)))
 
 
-def ray_conditioning(coefficients: Program, view: View, rays: int = RAYS) -> Conditioning | None:
+def ray_conditioning(coefficients: Program, view: View,
+                     rays: int | None = None) -> Conditioning | None:
     """How far float32's rounding of the ray polynomial's coefficients moves the first
     root, on `view`'s pixel rays (None: no ray has a root). The coefficients c_0..c_n about
     the chord's middle are computed by `coefficients` (raypoly.coefficient_program, the
     shader's own program) from the same float32 ray once in float32 and once in float64;
     the float64 polynomial's first root u (a sign change) moves by |dF(u)| / |F'(u)|.
     Where the exact method's Newton reads F from these coefficients, its roots land there."""
+    if rays is None:
+        rays = RAYS if len(coefficients.assignments) <= LONG_PROGRAM else RAYS // 2
     origins, dirs = pixel_rays(view, rays, rays)
     origins, dirs = origins.reshape(-1, 3), dirs.reshape(-1, 3)
     t0, t1, inside = clip_sphere(origins, dirs, view.clip_center, view.clip_radius)

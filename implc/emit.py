@@ -25,7 +25,7 @@ from .marcher import choose_form, lower, point_sets
 from .methods import Constants, Method, get_method
 from .optimize import Program
 from .pieces import build_programs, function_name
-from .resources import data_dir
+from .resources import cache_dir, data_dir
 from .scaling import scale_exponent, scale_note, scaled
 from .scene import SHADING, View, light_directions, shading_for
 from .surface import Surface
@@ -74,8 +74,10 @@ def environment(target: str | None = None) -> jinja2.Environment:
     """The template environment; for a target, with its printer as the global `printer`,
     through which templates/<target>/lang.j2 spells select and the table's functions
     (an imported template sees globals, not the render's context)."""
+    cache = cache_dir("templates")  # compiled templates: 0.3 s of every cold compile
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(data_dir("templates"))),
+        bytecode_cache=jinja2.FileSystemBytecodeCache(str(cache)) if cache else None,
         undefined=jinja2.StrictUndefined,
         keep_trailing_newline=True,
         trim_blocks=True,

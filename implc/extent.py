@@ -25,7 +25,7 @@ from functools import lru_cache
 import numpy as np
 import sympy
 
-from .numeric import evaluate
+from .numeric import evaluate, evaluate_on_grid
 from .scene import Extent, Vec3
 from .symbols import POINT
 
@@ -153,9 +153,7 @@ def sign_changes(expr: sympy.Expr, center: np.ndarray,
     them lies in the cube's outer layer of cells) for the cube of half-size `half`."""
     spacing = 2.0 * half / GRID
     axes = [c - half + spacing * (SHIFT + np.arange(GRID + 1)) for c in center]
-    grid = np.meshgrid(*axes, indexing="ij")
-    values = evaluate(expr, dict(zip(POINT, grid, strict=True)))
-    values = np.broadcast_to(values, grid[0].shape)
+    values = evaluate_on_grid(expr, axes)
     sign = np.sign(values)  # NaN stays NaN: an edge with a NaN end is no sign change
     found = []
     touching = False

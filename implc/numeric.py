@@ -12,6 +12,7 @@ import numpy as np
 import sympy
 
 from .functions import BY_SYMPY_NAME
+from .symbols import POINT
 
 
 def evaluate(expr: sympy.Expr, env: Mapping[sympy.Symbol, np.ndarray]) -> np.ndarray:
@@ -108,3 +109,44 @@ def _pow(base, exp, env, cache, real=np.float64):
     if exp == sympy.Rational(1, 2):
         return np.sqrt(base)
     return np.power(base, _eval(exp, env, cache, real))
+
+
+def evaluate_on_grid(expr: sympy.Expr, axes: Sequence[np.ndarray]) -> np.ndarray:
+    """S on the tensor grid axes[0] x axes[1] x axes[2], shape (len(axes[0]), ...).
+
+    A sum of monomials c x^i y^j z^k (an equation written out at length, such as the
+    corpus's degree-18 torus knot with its 207 terms) is contracted one axis at a time
+    from its coefficient tensor: about n^3 (d + 1) operations for d + 1 coefficients an
+    axis, where the walker forms every monomial at every one of the n^3 points (1 s
+    against 0.02 s for that knot on framing's 65^3 grid). Anything else: the walker."""
+    monomials = _monomials(expr)
+    if monomials is None:
+        grid = np.meshgrid(*axes, indexing="ij")
+        values = evaluate(expr, dict(zip(POINT, grid, strict=True)))
+        return np.broadcast_to(values, grid[0].shape)
+    degrees = [max(m[axis] for m in monomials) + 1 for axis in range(3)]
+    tensor = np.zeros(degrees)
+    for exponents, coefficient in monomials.items():
+        tensor[exponents] += coefficient
+    powers = [np.asarray(a, dtype=np.float64)[None, :] ** np.arange(d)[:, None]
+              for a, d in zip(axes, degrees, strict=True)]
+    with np.errstate(all="ignore"):
+        return np.einsum("ijk,ia,jb,kc->abc", tensor, *powers, optimize=True)
+
+
+def _monomials(expr: sympy.Expr) -> dict[tuple[int, int, int], float] | None:
+    """{(i, j, k): c} of a sum of monomials c x^i y^j z^k with numeric c, else None."""
+    result: dict[tuple[int, int, int], float] = {}
+    for term in sympy.Add.make_args(expr):
+        coefficient, rest = term.as_coeff_Mul()
+        if not coefficient.is_Number:
+            return None
+        exponents = [0, 0, 0]
+        for factor in sympy.Mul.make_args(rest) if rest != 1 else ():
+            base, exp = factor.as_base_exp()
+            if base not in POINT or not exp.is_Integer or exp < 1:
+                return None
+            exponents[POINT.index(base)] += int(exp)
+        key = (exponents[0], exponents[1], exponents[2])
+        result[key] = result.get(key, 0.0) + float(coefficient)
+    return result

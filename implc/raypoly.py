@@ -104,11 +104,11 @@ def _horner(terms: dict, order: tuple[int, ...], n: int, combine, precision: str
     scheme nested in `order`; `combine(parts)` makes the value sum value*factor (factor
     None: the value alone) of each coefficient of each step, or counts it."""
     variables = [POINT[i] for i in order]
+    keys = [_permuted(m, order) for m in terms]  # each monomial's exponents in `order`
 
     def level(depth: int, prefix: tuple[int, ...]) -> list:
         """sum, over the monomials whose first exponents are `prefix`, of the rest."""
-        below = [_permuted(m, order)[depth:] for m in terms
-                 if _permuted(m, order)[:depth] == prefix]
+        below = [key[depth:] for key in keys if key[:depth] == prefix]
         exponents = {rest[0] for rest in below}
         # x^e alone (no later variable with it, e >= 1): a constant a_e, summed by a
         # Taylor shift (_shifted), the rest by Horner's loop

@@ -37,9 +37,12 @@ class Timing:
 
 def command(row, out: Path) -> list[str]:
     """The row as a user types it (params as corpus.row_surface passes them)."""
+    from implc.loaders.common import equation_words
+
     argv = [sys.executable, "-m", "implc", "compile", "-e", row.equation, "-o", str(out)]
+    named = equation_words(row.equation)  # a family's parameters this member does not use
     for name, value in row.params.items():
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
+        if name in named and isinstance(value, (int, float)) and not isinstance(value, bool):
             argv += ["--param", f"{name}={float(value)!r}"]
     return argv
 

@@ -363,3 +363,25 @@ def test_a_periodic_surface_is_framed_a_period_each_way():
     assert scaled.radius == pytest.approx(2.1)  # 2 pi / 3
     proc = implc("render", "-e", gyroid, "-b", "reference", "--size", "32", "-o", "/dev/null")
     assert "a period (6.3) each way" in proc.stderr, proc.stderr
+
+
+# --- issue 44, point 9: framing samples an expanded polynomial by contraction ---------------
+
+def test_a_sum_of_monomials_on_the_grid_is_the_walkers_value():
+    """numeric.evaluate_on_grid contracts the coefficient tensor axis by axis (the corpus's
+    degree-18 knot: 0.01 s against the walker's 0.5 s on the 65^3 grid); its values are
+    the walker's to rounding, and every other tree goes to the walker itself."""
+    from implc.numeric import evaluate, evaluate_on_grid
+    from implc.symbols import POINT
+
+    axes = [np.linspace(-2.0, 1.5, 17), np.linspace(-1.0, 2.0, 13), np.linspace(-3.0, 3.0, 11)]
+    grid = np.meshgrid(*axes, indexing="ij")
+    for text in ("x^18 + 9x^16 y^2 - 40x^14 y z/7 + 2y^10 z^8 + x y z - 3/10",
+                 "x^3 y - 2 z^5 + 1e-3 x^2 z^2 + 4",
+                 "(x^2 + y^2 + z^2 - 1)^2 - x",  # not expanded: the walker
+                 "sin(3x) + y z^2"):
+        e = expr(text)
+        fast = evaluate_on_grid(e, axes)
+        slow = np.broadcast_to(evaluate(e, dict(zip(POINT, grid, strict=True))), fast.shape)
+        assert fast.shape == (17, 13, 11)
+        assert np.allclose(fast, slow, rtol=1e-12, atol=1e-12 * np.abs(slow).max()), text
