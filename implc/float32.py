@@ -64,22 +64,23 @@ class Float32Report:
 
 def float32_report(expr: sympy.Expr, view: View, degree: int,
                    gradient: tuple[sympy.Expr, ...] | None = None,
-                   point: bool = True) -> Float32Report:
+                   point: bool = True, ray: bool = True) -> Float32Report:
     """The ray coefficients' measure where exact's Newton reads F from them (degree
-    ROBUST_NEWTON_BELOW to EXACT_MAX_DEGREE), and S's at any degree unless `point` is
-    False (0.04-0.3 s: what a warning for exact alone does not need). Both measure S as the
+    ROBUST_NEWTON_BELOW to EXACT_MAX_DEGREE) unless `ray` is False (what a warning for
+    another method does not need), and S's at any degree unless `point` is False
+    (0.04-0.3 s: what a warning for exact alone does not need). Both measure S as the
     shader has it: brought near 1 by a power of two where its constants are extreme."""
     scale = scale_exponent(expr)  # measured as the shader computes it (implc/scaling.py)
     expr = scaled(expr, scale)
     if gradient is not None:
         gradient = tuple(scaled(g, scale) for g in gradient)
-    ray = (ray_conditioning(coefficient_program(expr, "float"), view)
-           if ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
+    rays = (ray_conditioning(coefficient_program(expr, "float"), view)
+            if ray and ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
     if not point:
-        return Float32Report(None, ray)
+        return Float32Report(None, rays)
     if gradient is None:
         gradient = tuple(sympy.diff(expr, v) for v in POINT)
-    return Float32Report(float32_conditioning(expr, gradient), ray)
+    return Float32Report(float32_conditioning(expr, gradient), rays)
 
 
 def float32_warning(surface: Surface, method: str) -> str | None:
@@ -91,5 +92,6 @@ def float32_warning(surface: Surface, method: str) -> str | None:
     if degree is None:
         return None
     report = float32_report(surface.expr, surface.view, degree,
-                            point=method != "exact" or degree < ROBUST_NEWTON_BELOW)
+                            point=method != "exact" or degree < ROBUST_NEWTON_BELOW,
+                            ray=method == "exact")  # another method reads no coefficients
     return report.warning(method)

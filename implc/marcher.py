@@ -68,6 +68,7 @@ from .raypoly import (
     coefficient_program,
     estrin_function,
     from_ray,
+    horner_ops,
     ray_name,
     ray_quantity_ops,
     ray_setup,
@@ -147,13 +148,26 @@ def default_method(expr: sympy.Expr) -> str:
     functions all have interval rules (no missed sign change; faster than hessian on every
     bundled non-polynomial, docs/RESULTS.md), else `hessian`."""
     degree = polynomial_degree(expr)
-    if degree is not None and degree <= EXACT_MAX_DEGREE:
+    if degree is not None and degree <= EXACT_MAX_DEGREE and not _exact_too_long(expr):
         return "exact"
     try:
         check_interval(expr)
     except InputError:
         return "hessian"
     return "interval"
+
+
+# exact's ray coefficients by Horner's scheme (a polynomial written out at length, or
+# whose tree would be too large), in operations, above which the default method is the
+# interval walk: a product of ten dense quadratics expands to 1,771 monomials and 31,456
+# operations, 4.4 s of compiling and a shader of 18,000 lines, where its interval program
+# is S as written. The corpus's longest, row 246's degree-18 knot, takes 7,221.
+EXACT_DEFAULT_MAX_OPS = 15_000
+
+
+def _exact_too_long(expr: sympy.Expr) -> bool:
+    ops = horner_ops(expr)
+    return ops is not None and ops > EXACT_DEFAULT_MAX_OPS
 
 
 # --- what a method evaluates where ---------------------------------------------------

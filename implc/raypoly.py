@@ -12,7 +12,7 @@ from math import comb
 
 import sympy
 
-from .derive import polynomial_degree, ray_coefficients
+from .derive import expanded_terms, fold_tree, polynomial_degree, ray_coefficients
 from .errors import InputError
 from .optimize import Program, count_ops, optimize
 from .pieces import (
@@ -44,9 +44,20 @@ def coefficient_program(expr: sympy.Expr, precision: str) -> Program:
 
 
 def coefficient_route(expr: sympy.Expr) -> str:
-    """"horner" for an equation written out at length, else "tree" (see
-    coefficient_program; `implc show` says which)."""
-    return "horner" if count_ops(expr) > HORNER_ABOVE else "tree"
+    """"horner" for an equation written out at length, or one whose tree route would
+    write coefficients of more than TREE_ABOVE nodes (counted with repeats: what CSE
+    walks), else "tree" (see coefficient_program; `implc show` says which)."""
+    if count_ops(expr) > HORNER_ABOVE:
+        return "horner"
+    coefficients = ray_coefficients(expr) or ()
+    return "horner" if tree_size(coefficients) > TREE_ABOVE else "tree"
+
+
+def tree_size(exprs: Sequence[sympy.Expr]) -> int:
+    """The expressions' size in nodes with every repeat counted (a DAG's tree size), in one
+    pass over their distinct nodes; saturates at TREE_CAP."""
+    sizes = [fold_tree(e, lambda _, parts: min(TREE_CAP, 1 + sum(parts))) for e in exprs]
+    return min(TREE_CAP, sum(sizes))
 
 
 # S's size in operations, as written, above which the ray coefficients come by Horner's
@@ -58,6 +69,12 @@ def coefficient_route(expr: sympy.Expr) -> str:
 # 84 against 67 operations, Clebsch 216 against 109: the same exact frame at 512^2,
 # since ray_of runs once a ray).
 HORNER_ABOVE = 150
+# The tree route's coefficients, counted with repeats, above which Horner's is taken: a
+# product of 20 linear factors, (x-1)(x-2)...(x-20) + y^2 + z^2 (43 operations as written),
+# gives coefficients of 6.3 million nodes, whose CSE took 16 s; Horner's 0.06 s (452
+# operations). The bundled examples' largest is Barth's decic, 4,004.
+TREE_ABOVE = 50_000
+TREE_CAP = 10**12
 
 
 def horner_program(expr: sympy.Expr, precision: str) -> Program:
@@ -68,21 +85,7 @@ def horner_program(expr: sympy.Expr, precision: str) -> Program:
     every step is named (q0, q1, ...), so the program needs no CSE. The orders are
     compared by counting alone (building one order's sympy expressions is the cost).
     `precision` chooses how powers standing alone are shifted (_shifted)."""
-    poly = sympy.Poly(expr, *POINT)
-    n = int(poly.total_degree())
-    terms = dict(poly.terms())
-
-    def count(parts: list[tuple[object, sympy.Symbol | None]]) -> int:
-        nonlocal ops
-        ops += len(parts) - 1 + sum(1 for _, factor in parts if factor is not None)
-        return 0
-
-    costs = []
-    for order in itertools.permutations(range(3)):
-        ops = 0
-        _horner(terms, order, n, count, precision)
-        costs.append((ops, order))
-    order = min(costs)[1]  # the first of equals: deterministic
+    terms, n, _, order = _horner_plan(expr, precision)
     assignments: list[tuple[sympy.Symbol, sympy.Expr]] = []
 
     def named(parts: list[tuple[sympy.Expr, sympy.Symbol | None]]) -> sympy.Expr:
@@ -97,6 +100,36 @@ def horner_program(expr: sympy.Expr, precision: str) -> Program:
     outputs += [sympy.S.Zero] * (n + 1 - len(outputs))
     total = sum(count_ops(v) for _, v in assignments)
     return Program(POINT + DIRECTION, tuple(assignments), tuple(outputs), total, total)
+
+
+@lru_cache(maxsize=8)
+def _horner_plan(expr: sympy.Expr, precision: str) -> tuple[dict, int, int, tuple[int, ...]]:
+    """S's monomials, its degree, and the operations and order of the cheapest Horner
+    nesting (the first of equals: deterministic), by counting alone."""
+    terms = expanded_terms(expr)
+    n = max(sum(m) for m in terms)
+    ops = 0
+
+    def count(parts: list[tuple[object, sympy.Symbol | None]]) -> int:
+        nonlocal ops
+        ops += len(parts) - 1 + sum(1 for _, factor in parts if factor is not None)
+        return 0
+
+    costs = []
+    for order in itertools.permutations(range(3)):
+        ops = 0
+        _horner(terms, order, n, count, precision)
+        costs.append((ops, order))
+    best, order = min(costs)
+    return terms, n, best, order
+
+
+def horner_ops(expr: sympy.Expr, precision: str = "float") -> int | None:
+    """The operations of the ray coefficients' program where it takes Horner's route
+    (None: the tree's route, never long: see TREE_ABOVE), known before it is built."""
+    if coefficient_route(expr) != "horner":
+        return None
+    return _horner_plan(expr, precision)[2]
 
 
 def _horner(terms: dict, order: tuple[int, ...], n: int, combine, precision: str) -> list:

@@ -320,3 +320,27 @@ def test_degree_agrees_with_sympy_on_every_example_and_corpus_row():
     assert len(polynomials) > 60
     for expr in polynomials:
         assert polynomial_degree(expr) == sympy.Poly(expr, *POINT).total_degree(), expr
+
+
+# --- issue 44 point 9: expansion without sympy's general expand -------------------------
+
+@pytest.mark.parametrize("text", [
+    "x^18 + 9x^16 y^2 - 40x^14 y z/7 + 2y^10 z^8 + x y z - 3/10",
+    "4x^2(x^2 + y^2 + z^2 + z) + y^2(y^2 + z^2 - 1)",
+    "(x^2 + y^2 + z^2 + x y + 1)^5 - (x - y)^3 z + 1/7",
+    "(x - 1)(x - 2)(x - 3)(x - 4) + y^2 + z^2",
+    "(x^2 + y^2 + z^2 - sqrt(5))^2 - 2x",  # the parser folds sqrt(5) to a 30-digit float
+])
+def test_expanded_terms_are_sympys_monomials(text):
+    """derive.expanded_terms (Horner's route reads it) gives Poly(S).terms() exactly."""
+    from implc.derive import expanded_terms
+
+    expr = load_surface(equation=text).expr
+    expected = dict(sympy.Poly(expr, *POINT).terms())
+    got = expanded_terms(expr)
+    assert got.keys() == expected.keys()
+    for m, c in got.items():  # exact where Poly is (its float domain rounds: 30 digits)
+        if c.is_Rational and expected[m].is_Rational:
+            assert c == expected[m], (text, m)
+        else:
+            assert abs(float(c - expected[m])) <= 1e-25 * max(1.0, abs(float(c))), (text, m)

@@ -324,3 +324,32 @@ def test_exact_holds_on_equations_written_out_at_length(number):
     surface = row_surface(next(r for r in load_rows(tsv) if r.number == number))
     assert coefficient_route(surface.expr) == "horner"
     _assert_exact_at_128(surface, "gl", fill=0.05)
+
+
+# --- issue 44 point 9: inputs whose exact program would be long ---------------------------
+
+def test_a_product_of_many_factors_takes_horners_route():
+    """(x-1)(x-2)...(x-20) + y^2 + z^2 is 43 operations as written, but the tree route's
+    ray coefficients are 6.3 million nodes (their CSE took 16 s): Horner's route, 452
+    operations, is taken by their size (raypoly.TREE_ABOVE)."""
+    from implc.raypoly import coefficient_program, coefficient_route
+
+    text = "*".join(f"(x-{i})" for i in range(1, 21)) + " + y^2 + z^2"
+    expr = load_surface(equation=text).expr
+    assert coefficient_route(expr) == "horner"
+    program = coefficient_program(expr, "float")
+    assert len(program.outputs) == 21 and program.ops_after < 1000
+
+
+def test_a_polynomial_too_long_for_exact_defaults_to_the_interval_walk():
+    """Ten dense quadratics multiplied: 1,771 monomials, 31,456 operations by Horner (4.4 s
+    of compiling, an 18,000-line shader): the default method is interval, S as written;
+    Chmutov's T_18 keeps exact (the corpus's longest polynomial, row 246, takes 7,221)."""
+    from implc.marcher import EXACT_DEFAULT_MAX_OPS, default_method
+    from implc.raypoly import horner_ops
+
+    text = "*".join(f"(x^2+y^2+z^2+x*y+y*z+z*x+{i}*x+y-z+{i})" for i in range(1, 11)) + " - 1"
+    expr = load_surface(equation=text).expr
+    assert horner_ops(expr) > EXACT_DEFAULT_MAX_OPS
+    assert default_method(expr) == "interval"
+    assert default_method(load_surface(equation=chmutov(18)).expr) == "exact"
