@@ -68,7 +68,7 @@ golden: setup
 
 # ruff; mypy --strict over the public API (implc/__init__.py, implc/api/); and node's parser over the viewer's script (templates/view/viewer.js, which
 # viewer.html.j2 includes), so a syntax error there fails here, not in a user's browser.
-JS_SOURCES := $(sort $(wildcard templates/*/*.js))
+JS_SOURCES := $(sort $(wildcard templates/*/*.js templates/*/*.mjs))
 lint: setup
 	$(PY) -m ruff check implc tests
 	$(PY) -m mypy --strict --follow-imports=silent --ignore-missing-imports --no-error-summary \

@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from ..scene import Framing, View
     from ..surface import Surface as SurfaceRecord
     from .records import Rendering, Shader
+    from .widget import Viewer
 
 Point = tuple[float, float, float]
 _AXES = {"x": 0, "y": 1, "z": 2}
@@ -225,6 +226,24 @@ class Surface:
 
         method, values = resolve_method(self, method, constants)
         return viewer_page(self.framed()[0], method, values, webgpu=webgpu)
+
+    def show(self, method: str | None = None, *, size: int = 384, webgpu: bool = True,
+             backend: str = "webgl2", **constants: Any) -> Viewer:
+        """The live viewer as a notebook widget (anywidget: JupyterLab, Notebook 7, VS Code,
+        Colab, marimo): the shaders compiled here, drawn by the browser on a `size`-pixel
+        square; `w.params = {"a": 0.3}` moves the picture, moving a slider sets
+        `w.params`. Needs the `notebook` extra (`pip install implc[notebook]`)."""
+        from ..view import viewer_data
+        from .compiling import resolve_method
+
+        try:
+            from .widget import Viewer
+        except ImportError as err:  # anywidget absent: say what to install
+            raise ImportError("Surface.show() needs anywidget: pip install 'implc[notebook]'"
+                              ) from err
+        method, values = resolve_method(self, method, constants)
+        data = viewer_data(self.framed()[0], method, values, webgpu=webgpu)
+        return Viewer(data, size=size, backend=backend)
 
     def describe(self, method: str | None = None) -> str:
         """What implc understood and will compute (`implc show`): the equation, degree,
