@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from .widget import Viewer
 
 Point = tuple[float, float, float]
+INLINE_SIZE = 256  # the side of the picture a notebook shows
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
@@ -259,10 +260,22 @@ class Surface:
 
         return to_jsurf(self.framed()[0])
 
-    def _repr_png_(self) -> bytes | None:
-        """Jupyter's inline picture: a 256² render with the default method (llvmpipe
-        here; about 0.1-1 s)."""
-        return self.render(256).png()
+    def inline(self) -> Rendering:
+        """The picture a notebook shows: 256² with the default method on the default
+        backend (llvmpipe here), rendered once (the PNG and the HTML forms share it)."""
+        if "_inline" not in self.__dict__:
+            self.__dict__["_inline"] = self.render(INLINE_SIZE)
+        rendering: Rendering = self.__dict__["_inline"]
+        return rendering
+
+    def _repr_png_(self) -> bytes:
+        """Jupyter's inline picture (`inline`); the first in a fresh kernel, import
+        included, takes about 1-2 s here (docs/api.md)."""
+        return self.inline().png()
+
+    def _repr_html_(self) -> str:
+        """The same picture with its equation, method and warnings beside it."""
+        return self.inline().html(f"{self.name}: {self.equation}")
 
 
 def _param_args(params: Mapping[str, object] | None) -> tuple[str, ...]:
