@@ -140,5 +140,11 @@ startup: setup
 gallery-pictures: setup
 	$(PY) scripts/gallery_pictures.py
 
+# The README's notebook figure (docs/notebook-widget.png): tests/test_jupyterlab.py's
+# screenshot of the tour's widget cell in JupyterLab. About 30 s.
+.PHONY: notebook-picture
+notebook-picture: setup
+	IMPLC_SCREENSHOTS=docs $(PY) -m pytest tests/test_jupyterlab.py -q
+
 clean:
 	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules
