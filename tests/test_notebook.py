@@ -65,6 +65,34 @@ def test_rendering_and_shader_html_escape_their_text():
     assert html.unescape(pre) == shader.text  # ... and whole
 
 
+def test_inline_picture_without_gl_is_the_cpu_reference():
+    """No GPU is assumed, and not even GL: in a process whose EGL finds no driver (glvnd
+    pointed at no vendor library) the inline picture is the exact CPU reference, and its
+    caption says so."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = ("import json, implc\n"
+            "from implc.errors import ToolError\n"
+            "from implc.render.gl import context\n"
+            "try:\n    context(); gl = True\nexcept ToolError:\n    gl = False\n"
+            "s = implc.Surface.example('cross-cap')\n"
+            "print(json.dumps([gl, s.inline().backend, s._repr_html_(),"
+            " s.inline().hit_fraction]))\n")
+    env = {**os.environ, "__EGL_VENDOR_LIBRARY_FILENAMES": "/nonexistent/egl_vendor.json",
+           "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    gl, backend, page, hit = json.loads(proc.stdout)
+    if gl:
+        pytest.skip("this EGL is not glvnd's: the variable did not take GL away")
+    assert backend == "reference" and "256×256 reference/reference" in page
+    assert abs(hit - implc.Surface.example("cross-cap").inline().hit_fraction) < 0.01
+
+
 # --- the tour in a real kernel ------------------------------------------------------------
 def test_tour_notebook_runs_in_a_real_kernel(tmp_path):
     nbformat = require("nbformat")
