@@ -2,8 +2,9 @@
 opened in the headless Chromium the browser tests drive with Playwright. The tour
 notebook's cells tagged `jupyterlab` run there; the test reads the widget's canvas back and
 checks that the surface is drawn (not background), that moving a slider changes the
-picture and reaches Python (`w.params`), and that setting `w.params` in Python moves the
-slider and the picture.
+picture and reaches Python (`w.params`), that setting `w.params` in Python moves the
+slider and the picture, and that the WebGPU button draws the same frame (SSIM >= 0.99
+against WebGL2's; measured 1.0000 on SwiftShader).
 
 Bounds: a free port on 127.0.0.1, a random token, every Jupyter directory in the test's
 temporary directory, the server's start within SERVER_START_S, each browser wait within
@@ -37,6 +38,7 @@ from implc.scene import SHADING
 ROOT = Path(__file__).resolve().parent.parent
 SERVER_START_S = 90
 SSIM_CHANGED = 0.95  # as tests/test_view.py: a frame that must differ scores below this
+SSIM_SAME = 0.99  # as tests/test_view.py: WebGPU's frame is WebGL2's (both float32)
 MIN_DRAWN = 0.05  # at least this share of the canvas shows the surface, not background
 
 
@@ -207,6 +209,14 @@ def test_widget_draws_and_syncs_in_jupyterlab(browser, tmp_path):
         }}""")
         from_python = screenshot(canvas)
         slider_value = float(slider.input_value())
+        # WebGPU, where this Chromium has it (SwiftShader's Vulkan here): the same picture
+        page.wait_for_function(f"() => ({VIEWER})().implcViewer.ready")
+        webgpu = page.evaluate(f"() => ({VIEWER})().implcViewer.webgpu")
+        if webgpu == "available":
+            page.locator(".jp-OutputArea-output #use-webgpu").click()
+            wait_drawn(page, viewer_state(page)["frames"])
+            on_webgpu = screenshot(page.locator(".jp-OutputArea-output #gpu-canvas"))
+            assert page.evaluate(f"() => ({VIEWER})().implcViewer.backend") == "webgpu"
         problems = [p for p in log.problems() if "favicon" not in p]
     print(f"JupyterLab widget: {100 * drawn:.1f} % of the canvas drawn; slider to a=0.2: "
           f"SSIM {ssim(first, moved):.3f} vs the first frame; w.params after it: "
@@ -217,5 +227,9 @@ def test_widget_draws_and_syncs_in_jupyterlab(browser, tmp_path):
     assert after_slider.strip() == "{'a': 0.2}"
     assert slider_value == 0.5
     assert ssim(moved, from_python) < SSIM_CHANGED
+    assert webgpu == "available", f"no WebGPU in the widget: {webgpu}"
+    webgpu_ssim = ssim(on_webgpu, from_python)
+    print(f"the same frame on WebGPU: SSIM {webgpu_ssim:.4f} vs WebGL2")
+    assert webgpu_ssim >= SSIM_SAME
     assert np.abs(from_python - first).max() > 0
     assert problems == []
