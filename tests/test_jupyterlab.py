@@ -4,7 +4,8 @@ notebook's cells tagged `jupyterlab` run there; the test reads the widget's canv
 checks that the surface is drawn (not background), that moving a slider changes the
 picture and reaches Python (`w.params`), that setting `w.params` in Python moves the
 slider and the picture, and that the WebGPU button draws the same frame (SSIM >= 0.99
-against WebGL2's; measured 1.0000 on SwiftShader).
+against WebGL2's; measured 1.0000 on SwiftShader). Every request the page makes after it
+opened goes to that server (or is data: or blob:): the widget needs no network.
 
 Bounds: a free port on 127.0.0.1, a random token, every Jupyter directory in the test's
 temporary directory, the server's start within SERVER_START_S, each browser wait within
@@ -181,6 +182,8 @@ def test_widget_draws_and_syncs_in_jupyterlab(browser, tmp_path):
     with jupyterlab(tmp_path) as (base, token), \
             open_page(browser, f"{base}/lab/tree/{notebook.name}?token={token}",
                       width=1200, height=900) as (page, log):
+        requests: list[str] = []
+        page.on("request", lambda request: requests.append(request.url))
         page.locator(".jp-Notebook .jp-Cell").first.wait_for()
         for index in range(widget_at + 1):
             run_cell(page, index)
@@ -233,3 +236,5 @@ def test_widget_draws_and_syncs_in_jupyterlab(browser, tmp_path):
     assert webgpu_ssim >= SSIM_SAME
     assert np.abs(from_python - first).max() > 0
     assert problems == []
+    elsewhere = [u for u in requests if not u.startswith((base, "data:", "blob:"))]
+    assert requests and elsewhere == [], f"requests off this server: {elsewhere}"
