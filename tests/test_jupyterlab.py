@@ -4,8 +4,10 @@ notebook's cells tagged `jupyterlab` run there; the test reads the widget's canv
 checks that the surface is drawn (not background), that moving a slider changes the
 picture and reaches Python (`w.params`), that setting `w.params` in Python moves the
 slider and the picture, and that the WebGPU button draws the same frame (SSIM >= 0.99
-against WebGL2's; measured 1.0000 on SwiftShader). Every request the page makes after it
-opened goes to that server (or is data: or blob:): the widget needs no network.
+against WebGL2's; measured 1.0000 on SwiftShader); shown twice, the widget has two views
+(each in its own shadow root) on one model, so a slider of one moves the other. Every
+request the page makes after it opened goes to that server (or is data: or blob:): the
+widget needs no network.
 
 Bounds: a free port on 127.0.0.1, a random token, every Jupyter directory in the test's
 temporary directory, the server's start within SERVER_START_S, each browser wait within
@@ -122,6 +124,10 @@ VIEWER = """() => {
 }"""
 
 
+VIEWERS = """() => Array.from(document.querySelectorAll(".jp-OutputArea-output *"))
+  .filter((el) => el.implcViewer).map((el) => el.implcViewer)"""
+
+
 def viewer_state(page) -> dict:
     return page.evaluate(f"""() => {{
       const el = ({VIEWER})();
@@ -220,6 +226,27 @@ def test_widget_draws_and_syncs_in_jupyterlab(browser, tmp_path):
             wait_drawn(page, viewer_state(page)["frames"])
             on_webgpu = screenshot(page.locator(".jp-OutputArea-output #gpu-canvas"))
             assert page.evaluate(f"() => ({VIEWER})().implcViewer.backend") == "webgpu"
+        # the same widget shown again: a second view in its own shadow root (the same ids
+        # twice in the page, no clash), one model: its slider moves the first view too
+        page.evaluate("""async (index) => {
+          const panel = window.jupyterapp.shell.currentWidget;
+          panel.content.activeCellIndex = index;
+          await window.jupyterapp.commands.execute("notebook:insert-cell-below");
+          panel.content.activeCell.model.sharedModel.setSource("w");
+        }""", set_at)
+        run_cell(page, set_at + 1)
+        page.wait_for_function(f"""() => {{
+          const views = ({VIEWERS})();
+          return views.length === 2 && views.every((v) => v.frames > 0 && v.idle);
+        }}""")
+        first_view_frames = page.evaluate(f"() => ({VIEWERS})()[0].frames")
+        page.locator(".jp-OutputArea-output #param-a").nth(1).fill("0.8")
+        page.wait_for_function(f"""() => {{
+          const [one, two] = ({VIEWERS})();
+          return one.params.a === two.params.a && two.params.a !== 0.5 && one.idle &&
+                 one.frames > {first_view_frames};
+        }}""")
+        both = page.evaluate(f"() => ({VIEWERS})().map((v) => [v.params.a, v.error])")
         problems = [p for p in log.problems() if "favicon" not in p]
     print(f"JupyterLab widget: {100 * drawn:.1f} % of the canvas drawn; slider to a=0.2: "
           f"SSIM {ssim(first, moved):.3f} vs the first frame; w.params after it: "
@@ -235,6 +262,7 @@ def test_widget_draws_and_syncs_in_jupyterlab(browser, tmp_path):
     print(f"the same frame on WebGPU: SSIM {webgpu_ssim:.4f} vs WebGL2")
     assert webgpu_ssim >= SSIM_SAME
     assert np.abs(from_python - first).max() > 0
+    assert [error for _, error in both] == ["", ""] and abs(both[0][0] - 0.8) < 0.01
     assert problems == []
     elsewhere = [u for u in requests if not u.startswith((base, "data:", "blob:"))]
     assert requests and elsewhere == [], f"requests off this server: {elsewhere}"
