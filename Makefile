@@ -68,7 +68,7 @@ golden: setup
 
 # ruff; mypy --strict over the public API (implc/__init__.py, implc/api/); and node's parser over the viewer's script (templates/view/viewer.js, which
 # viewer.html.j2 includes), so a syntax error there fails here, not in a user's browser.
-JS_SOURCES := $(sort $(wildcard templates/*/*.js))
+JS_SOURCES := $(sort $(wildcard templates/*/*.js templates/*/*.mjs))
 lint: setup
 	$(PY) -m ruff check implc tests
 	$(PY) -m mypy --strict --follow-imports=silent --ignore-missing-imports --no-error-summary \
@@ -139,6 +139,12 @@ startup: setup
 .PHONY: gallery-pictures
 gallery-pictures: setup
 	$(PY) scripts/gallery_pictures.py
+
+# The README's notebook figure (docs/notebook-widget.png): tests/test_jupyterlab.py's
+# screenshot of the tour's widget cell in JupyterLab. About 30 s.
+.PHONY: notebook-picture
+notebook-picture: setup
+	IMPLC_SCREENSHOTS=docs $(PY) -m pytest tests/test_jupyterlab.py -q
 
 clean:
 	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules

@@ -91,6 +91,14 @@ class InputError(ImplcError):
         # what to do about it, printed as a last line `help: ...`
         self.help = help
 
+    def __str__(self) -> str:
+        """The whole diagnostic (place, source line, caret, help): what Python and a
+        notebook print after the exception's name, so a user of the API sees the caret
+        too; `message` is the bare message."""
+        if self.source is None:
+            return self.message + (f"\n  help: {self.help}" if self.help else "")
+        return self.render()
+
     def render(self) -> str:
         tail = f"\n  help: {self.help}" if self.help else ""
         if self.source is None:

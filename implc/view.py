@@ -11,6 +11,7 @@ or font (tests/test_view.py checks the text).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from .emit import emit, param_uniforms, render_template
 from .marcher import default_method
@@ -49,17 +50,19 @@ def sliders(surface: Surface) -> list[Slider]:
     return result
 
 
-def viewer_page(surface: Surface, method: str | None = None,
-                constants: Constants | None = None, webgpu: bool = True) -> str:
-    """The HTML text of the viewer for `surface` (deterministic, byte for byte); the
-    method defaults as for `implc compile` (marcher.default_method)."""
+def viewer_data(surface: Surface, method: str | None = None,
+                constants: Constants | None = None, webgpu: bool = True) -> dict[str, Any]:
+    """What viewer.js draws (a JSON-able dict): the surface's name and equation, the method,
+    the view, the sliders and the shader texts; the page embeds it, the notebook widget
+    sends it as a traitlet. The method defaults as for `implc compile`
+    (marcher.default_method)."""
     method = method or default_method(surface.expr)
     meth = get_method(method)
     constants = constants or meth.defaults
     glsl = emit(surface, "glsl", method, constants, flavor="es300", params="uniform")
     wgsl = emit(surface, "wgsl", method, constants, params="uniform") if webgpu else ""
     view = surface.view
-    data = {
+    return {
         "surface": {"name": surface.name, "equation": surface.symbolic_equation,
                     "origin": surface.origin},
         "method": {"name": meth.name, "summary": meth.summary,
@@ -83,4 +86,10 @@ def viewer_page(surface: Surface, method: str | None = None,
             "blit": render_template("view/blit.wgsl.j2") if webgpu else "",
         },
     }
+
+
+def viewer_page(surface: Surface, method: str | None = None,
+                constants: Constants | None = None, webgpu: bool = True) -> str:
+    """The HTML text of the viewer for `surface` (deterministic, byte for byte)."""
+    data = viewer_data(surface, method, constants, webgpu)
     return render_template("view/viewer.html.j2", data=data, title=surface.name)

@@ -25,7 +25,9 @@ def test_wheel_finds_templates_and_examples(tmp_path):
     )
     templates = site / "implc" / "templates"
     for name in ("marcher.j2", "glsl/lang.j2", "opencl/probe.cl", "baseline/cross-cap.frag.j2",
-                 "view/viewer.html.j2", "view/viewer.js", "view/viewer.css"):
+                 "view/viewer.html.j2", "view/viewer.js", "view/viewer.css",
+                 "view/viewer-body.html.j2", "view/widget.mjs", "view/widget.css",
+                 "notebook/figure.html.j2", "notebook/shader.html.j2"):
         assert (templates / name).is_file(), name
     # Run from an unrelated directory with only the installed copy on the path.
     env = {**os.environ, "PYTHONPATH": str(site)}

@@ -2,7 +2,9 @@
 
 Both are immutable and carry what the pipeline decided (the method, the evaluation form,
 the view, the uniforms) and what a user should know (`warnings`, `notes`), so no client
-decides it again. A Rendering shows itself in Jupyter (`_repr_png_`).
+decides it again. Both show themselves in Jupyter: a Rendering as its PNG, and as HTML
+with a caption and its warnings (which a bare PNG would hide); a Shader as its summary,
+warnings and text.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..emit import CompiledShader
+from ..emit import CompiledShader, render_template
 from ..errors import ValidationError
 from ..fileio import write_atomic
 from ..scene import View
@@ -66,6 +68,18 @@ class Shader(CompiledShader):
         path = Path(path)
         write_atomic(path, self.text)
         return path
+
+    def summary(self) -> str:
+        """One line: target, emit form, method, evaluation form, precision, size."""
+        parts = [f"{self.target} {self.emit}", f"method {self.method}", f"form {self.form}",
+                 self.precision, f"{self.text.count(chr(10))} lines"]
+        if self.prefix:
+            parts.insert(1, f"prefix {self.prefix}")
+        return " · ".join(parts)
+
+    def _repr_html_(self) -> str:
+        return render_template("notebook/shader.html.j2", summary=self.summary(),
+                               warnings=list(self.warnings), text=self.text)
 
 
 @dataclass(frozen=True)
@@ -155,6 +169,24 @@ class Rendering:
 
     def _repr_png_(self) -> bytes:
         return self.png()
+
+    def html(self, title: str | None = None) -> str:
+        """The picture as an HTML figure: the PNG inline, a caption (backend, method, hit
+        fraction, frame time) and every warning."""
+        import base64
+
+        caption = (f"{self.width}×{self.height} {self.backend}/{self.method} · "
+                   f"{100 * self.hit_fraction:.1f} % hit · frame "
+                   f"{1000 * self.timing.get('frame', 0.0):.1f} ms")
+        return render_template("notebook/figure.html.j2",
+                               png=base64.b64encode(self.png()).decode("ascii"),
+                               width=self.width, height=self.height,
+                               title=title or self.surface.name, caption=caption,
+                               warnings=[w.removeprefix("implc: warning: ")
+                                         for w in self.warnings])
+
+    def _repr_html_(self) -> str:
+        return self.html()
 
     def __repr__(self) -> str:
         return (f"<Rendering {self.surface.name!r} {self.width}x{self.height} "

@@ -27,8 +27,10 @@ if TYPE_CHECKING:
     from ..scene import Framing, View
     from ..surface import Surface as SurfaceRecord
     from .records import Rendering, Shader
+    from .widget import Viewer
 
 Point = tuple[float, float, float]
+INLINE_SIZE = 256  # the side of the picture a notebook shows
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
@@ -226,6 +228,24 @@ class Surface:
         method, values = resolve_method(self, method, constants)
         return viewer_page(self.framed()[0], method, values, webgpu=webgpu)
 
+    def show(self, method: str | None = None, *, size: int = 384, webgpu: bool = True,
+             backend: str = "webgl2", **constants: Any) -> Viewer:
+        """The live viewer as a notebook widget (anywidget: JupyterLab, Notebook 7, VS Code,
+        Colab, marimo): the shaders compiled here, drawn by the browser on a `size`-pixel
+        square; `w.params = {"a": 0.3}` moves the picture, moving a slider sets
+        `w.params`. Needs the `notebook` extra (`pip install implc[notebook]`)."""
+        from ..view import viewer_data
+        from .compiling import resolve_method
+
+        try:
+            from .widget import Viewer
+        except ImportError as err:  # anywidget absent: say what to install
+            raise ImportError("Surface.show() needs anywidget: pip install 'implc[notebook]'"
+                              ) from err
+        method, values = resolve_method(self, method, constants)
+        data = viewer_data(self.framed()[0], method, values, webgpu=webgpu)
+        return Viewer(data, size=size, backend=backend)
+
     def describe(self, method: str | None = None) -> str:
         """What implc understood and will compute (`implc show`): the equation, degree,
         derivatives, operation counts and float32's measures."""
@@ -240,10 +260,32 @@ class Surface:
 
         return to_jsurf(self.framed()[0])
 
-    def _repr_png_(self) -> bytes | None:
-        """Jupyter's inline picture: a 256² render with the default method (llvmpipe
-        here; about 0.1-1 s)."""
-        return self.render(256).png()
+    def inline(self) -> Rendering:
+        """The picture a notebook shows: 256² with the default method, rendered once (the
+        PNG and the HTML forms share it). No GPU is assumed: headless GL (llvmpipe where
+        there is no GPU), and where the kernel cannot open a GL context at all, the exact
+        CPU reference (its caption names the backend; ~1.5-3 s at 256²)."""
+        if "_inline" not in self.__dict__:
+            from ..errors import ToolError
+            from ..render.gl import context
+
+            try:
+                context()
+                backend = "gl"
+            except ToolError:
+                backend = "reference"
+            self.__dict__["_inline"] = self.render(INLINE_SIZE, backend=backend)
+        rendering: Rendering = self.__dict__["_inline"]
+        return rendering
+
+    def _repr_png_(self) -> bytes:
+        """Jupyter's inline picture (`inline`); the first in a fresh kernel, import
+        included, takes about 1-2 s here (docs/api.md)."""
+        return self.inline().png()
+
+    def _repr_html_(self) -> str:
+        """The same picture with its equation, method and warnings beside it."""
+        return self.inline().html(f"{self.name}: {self.equation}")
 
 
 def _param_args(params: Mapping[str, object] | None) -> tuple[str, ...]:

@@ -1,17 +1,22 @@
 "use strict";
-(function () {
-  const DATA = JSON.parse(document.getElementById("implc-data").textContent);
-  const query = new URLSearchParams(location.search);
-  const fixedSize = query.has("size") ? Math.max(8, Math.min(4096, parseInt(query.get("size"), 10) || 256)) : 0;
-  const $ = (id) => document.getElementById(id);
+// implc's live viewer, written once for two hosts. The page (viewer.html.j2) runs this file
+// as its script: the block at the end mounts the viewer on the page's own document. The
+// notebook widget (implc/api/widget.py) sends this file with widget.mjs after it as one ES
+// module, which mounts the viewer in a shadow root per view. `root` is a Document or a
+// ShadowRoot holding viewer-body.html.j2's markup; `DATA` is implc/view.py's viewer_data;
+// `options`: size (a fixed square canvas in pixels, 0: fill the stage), backend ("webgpu"
+// to start on WebGPU), onParams(params) after a slider moved, onError(message).
+function implcMount(root, DATA, options) {
+  const fixedSize = options.size ? Math.max(8, Math.min(4096, options.size)) : 0;
+  const $ = (id) => root.getElementById(id);
   const stage = $("stage"), glCanvas = $("gl-canvas"), gpuCanvas = $("gpu-canvas");
 
-  // What tests (and the curious) can read: window.implcViewer.
+  // What tests (and the curious) can read: the page's window.implcViewer, the widget's
+  // element's implcViewer.
   const viewer = {
     frames: 0, backend: "webgl2", error: "", lastFrameMs: NaN, webgpu: "unavailable",
     params: {}, ready: false,
   };
-  window.implcViewer = viewer;
 
   // --- small vector helpers -------------------------------------------------------
   const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
@@ -49,10 +54,12 @@
     const box = $("error");
     box.textContent = message;
     box.style.display = "block";
+    if (options.onError) options.onError(message);
   }
 
   // --- parameter sliders --------------------------------------------------------------
   if (!DATA.params.length) $("no-params").hidden = false;
+  const sliders = {};
   for (const p of DATA.params) {
     const row = document.createElement("div");
     row.className = "row";
@@ -73,10 +80,25 @@
       params[p.name] = parseFloat(input.value);
       out.textContent = params[p.name].toPrecision(4);
       requestFrame();
+      if (options.onParams) options.onParams(Object.assign({}, params));
     });
     row.append(label, input, out);
     $("params").append(row);
+    sliders[p.name] = { input, out };
   }
+  // Parameter values from outside (the widget's Python side): the picture and the sliders.
+  viewer.setParams = (values) => {
+    let changed = false;
+    for (const [name, value] of Object.entries(values || {})) {
+      const s = sliders[name];
+      if (!s || typeof value !== "number" || !isFinite(value) || params[name] === value) continue;
+      params[name] = value;
+      s.input.value = String(value);
+      s.out.textContent = value.toPrecision(4);
+      changed = true;
+    }
+    if (changed) requestFrame();
+  };
 
   // --- canvas size -------------------------------------------------------------------
   function activeCanvas() { return viewer.backend === "webgpu" ? gpuCanvas : glCanvas; }
@@ -242,8 +264,9 @@
     wanted = true;
     if (!busy) requestAnimationFrame(runFrame);
   }
+  let disposed = false;
   async function runFrame() {
-    if (!wanted || busy || viewer.error) return;
+    if (!wanted || busy || viewer.error || disposed) return;
     wanted = false;
     busy = true;
     try {
@@ -379,7 +402,8 @@
   Object.defineProperty(viewer, "camera", { get: () => camera, enumerable: true });
   // idle: no frame running or waiting (a test reads the canvas only then)
   Object.defineProperty(viewer, "idle", { get: () => !busy && !wanted, enumerable: true });
-  new ResizeObserver(() => requestFrame()).observe(stage);
+  const observer = new ResizeObserver(() => requestFrame());
+  observer.observe(stage);
 
   // --- start: WebGL2 first (its first frame is the surface's [view]), WebGPU alongside --
   $("source").textContent = currentShader();
@@ -390,12 +414,31 @@
   }
   requestFrame();
   initWebGPU().then(() => {
-    if (query.get("backend") === "webgpu" && !setBackend("webgpu")) showError("WebGPU: " + viewer.webgpu);
+    if (options.backend === "webgpu" && !setBackend("webgpu")) showError("WebGPU: " + viewer.webgpu);
   }).catch((err) => {
     viewer.webgpu = "failed: " + String(err.message || err);
-    if (query.get("backend") === "webgpu") showError(viewer.webgpu);
+    if (options.backend === "webgpu") showError(viewer.webgpu);
   }).finally(() => {
     viewer.ready = true;
     $("use-webgpu").title = viewer.webgpu;
   });
-})();
+
+  // The host removes the view (a notebook cell cleared): stop drawing, free the GPU.
+  viewer.dispose = () => {
+    disposed = true;
+    observer.disconnect();
+    if (gpu.device) gpu.device.destroy();
+    const lose = gl && gl.getExtension("WEBGL_lose_context");
+    if (lose) lose.loseContext();
+  };
+  return viewer;
+}
+
+// The page: its data in #implc-data, its options in the address (?size=256&backend=webgpu).
+if (typeof document !== "undefined" && document.getElementById("implc-data")) {
+  const query = new URLSearchParams(location.search);
+  window.implcViewer = implcMount(document, JSON.parse(document.getElementById("implc-data").textContent), {
+    size: query.has("size") ? parseInt(query.get("size"), 10) || 256 : 0,
+    backend: query.get("backend"),
+  });
+}
