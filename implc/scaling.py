@@ -45,11 +45,33 @@ def magnitude_log2(expr: sympy.Expr) -> float:
 
 def scale_exponent(expr: sympy.Expr) -> int:
     """k such that 2^k * S has its nominal magnitude near 1 (0 where it is already within
-    2^+-SCALE_BEYOND)."""
+    2^+-SCALE_BEYOND). Only where every constant of S, before and after, is a normal
+    float32 number: a constant float32 cannot hold as written is the compile's refusal
+    (`too large for float32`), and a scaling that pushed one out would change S."""
     log2 = magnitude_log2(expr)
     if not math.isfinite(log2) or abs(log2) <= SCALE_BEYOND:
         return 0
-    return -round(log2)
+    k = -round(log2)
+    if not (_in_float32(expr) and _in_float32(scaled(expr, k))):
+        return 0
+    return k
+
+
+def _in_float32(expr: sympy.Expr) -> bool:
+    """Every constant of S (exponents aside) 0 or a normal float32 number in magnitude."""
+    def combine(node: sympy.Basic, parts: list[bool]) -> bool:
+        if node.is_Number:
+            value = abs(float(node))
+            return value == 0.0 or FLOAT32_MIN <= value <= FLOAT32_MAX
+        if node.is_Pow:
+            return parts[0]
+        return all(parts)
+
+    return fold_tree(expr, combine)
+
+
+FLOAT32_MIN = 2.0 ** -126  # the smallest normal float32
+FLOAT32_MAX = 3.4028234663852886e38
 
 
 def scaled(expr: sympy.Expr, k: int) -> sympy.Expr:
