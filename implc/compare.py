@@ -102,6 +102,8 @@ def format_metrics(metrics: dict) -> str:
         ("A", f"{a['path']} ({a['surface']}, {a['backend']}/{a['method']})"),
         ("B", f"{b['path']} ({b['surface']}, {b['backend']}/{b['method']})"),
         ("ssim", f"{metrics['ssim']:.6f}"),
+        ("non-finite", f"{metrics['nonfinite_a']} (A), {metrics['nonfinite_b']} (B)  (pixels "
+                       "with a NaN or infinite colour, black in ssim)"),
         ("false hits", f"{metrics['false_hits']}  (A hit, B missed)"),
         ("missed hits", f"{metrics['missed_hits']}  (A missed, B hit)"),
         ("wrong root", f"{metrics['wrong_root']}  (both hit, |t_A - t_B| > {metrics['t_tol']:g})"),

@@ -67,7 +67,10 @@ WIDENING = {"float": (2.0**-22, 2.0**-126), "double": (2.0**-51, 2.0**-1022)}
 class RangeProgram:
     """Lets (symbol, value) in order, then the enclosure (lo, hi) over [A, B] of each
     expression asked for, F's first; a segment where F is undefined throughout (the square
-    root of a negative interval, ...) gets [1, 1], which the march skips."""
+    root of a negative interval, ...) gets [1, 1], which the march skips. F's enclosure is
+    exactly [-BIG, BIG] (see `unbounded`) where it holds 0 and a node of F's tree was
+    unbounded on the segment (a pole of 1/u or tan, log at 0): F may jump through 0 there
+    without a root."""
 
     assignments: tuple[tuple[sympy.Symbol, sympy.Basic], ...]
     bounds: tuple[tuple[sympy.Expr, sympy.Expr], ...]
@@ -92,17 +95,44 @@ def range_program(*exprs: sympy.Expr) -> RangeProgram:
     is enclosed once), from their trees (see the module's doc). Cached: the default
     method's check, the lowering and `show` ask for the same program."""
     builder = _Builder()
-    bounds = [builder.bound(e) for e in exprs]
+    bounds = [builder.bound(exprs[0])]
+    poles = list(builder.poles)  # F's own (F''s, of sqrt at 0 say, are not F's)
+    bounds += [builder.bound(e) for e in exprs[1:]]
+    if poles:  # marked only where 0 is held: what the march skips stays skipped
+        lo, hi = bounds[0]
+        pole = sympy.Or(*poles) & (lo <= 0) & (hi >= 0)
+        bounds[0] = (Piecewise((-BIG, pole), (lo, True)), Piecewise((BIG, pole), (hi, True)))
     dead = sympy.Or(*builder.dead) if builder.dead else sympy.false
     if dead is not sympy.false:
         bounds = [tuple(Piecewise((1, dead), (v, True)) for v in pair) for pair in bounds]
     return RangeProgram(tuple(builder.lets), tuple(bounds))
 
 
+def unbounded(lo, hi):
+    """Whether F's enclosure (lo, hi), numbers or arrays, is the pole mark [-BIG, BIG] (or
+    overflowed past it): F may be discontinuous on the segment, and its sign change there
+    is no root."""
+    return (lo <= -BIG) & (hi >= BIG)
+
+
+def _big_branch(value: sympy.Basic) -> sympy.Basic:
+    """The condition under which `value` takes a +-BIG branch of its Piecewise (a rule's
+    bound where the function is unbounded), else false."""
+    if not isinstance(value, Piecewise):
+        return sympy.false
+    taken, earlier = [], []
+    for branch, cond in value.args:
+        if branch in (BIG, -BIG):
+            taken.append(sympy.And(cond, *(sympy.Not(c) for c in earlier)))
+        earlier.append(cond)
+    return sympy.Or(*taken)
+
+
 class _Builder:
     def __init__(self) -> None:
         self.lets: list[tuple[sympy.Symbol, sympy.Basic]] = []
         self.dead: list[sympy.Basic] = []
+        self.poles: list[sympy.Basic] = []  # where a bound was unbounded (+-BIG)
         self.memo: dict[sympy.Basic, tuple[sympy.Expr, sympy.Expr]] = {}
         self.named: dict[sympy.Basic, sympy.Symbol] = {}  # a value let twice: one name
 
@@ -119,6 +149,10 @@ class _Builder:
                 absolute: float = 0) -> tuple[sympy.Expr, sympy.Expr]:
         """[lo, hi] pushed outward by each bound's rounding (ulps units of |bound|, plus
         absolute and TINY)."""
+        for bound in (lo, hi):
+            pole = _big_branch(bound)
+            if pole is not sympy.false and pole not in self.poles:
+                self.poles.append(pole)
         if ulps == 0 and absolute == 0:
             return self.let(lo, "lo"), self.let(hi, "hi")
         if lo.is_number and hi.is_number:  # a constant: printed as one literal
@@ -288,5 +322,6 @@ def range_constants(printer, prefix: str) -> tuple[tuple[str, str, str], ...]:
             ("real", K + "START_WIDTH", printer.float_literal(2.0**-START)),
             ("real", K + "MIN_WIDTH", printer.float_literal(2.0**-DEPTH)),
             ("real", K + "TOUCH", printer.float_literal(TOUCH)),
+            ("real", K + "BIG", printer.float_literal(BIG)),
             ("int", K + "DEPTH", str(DEPTH)),
             ("int", K + "MAX_NODES", str(MAX_NODES)))

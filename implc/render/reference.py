@@ -21,8 +21,9 @@ sign change holds the first root to within its width: both are bisected to
 BISECTION_WIDTH. The first root (or exact zero of F) along the ray is the hit.
 Guarantee: no sign change of F is missed, whatever its roots' spacing, up to the float64
 rounding of S's point values (the enclosures are widened for their own rounding); only
-two roots inside one leaf (~1e-12 of the chord) show no sign change. (A jump through a
-pole, of tan or 1/u, is a sign change too, as in the shaders' leaf test.) Tangential
+two roots inside one leaf (~1e-12 of the chord) show no sign change. A jump through a
+pole, of tan or 1/u, is no root: a leaf where F's enclosure is marked unbounded is
+dropped, as in the `interval` method's leaf test, and the search goes on behind it. Tangential
 roots, where F touches 0 without a sign change, are found within TOUCH_TOL: a node (a
 dropped one where F' may vanish, or a leaf) whose |F(mid)| / |grad S| <= TOUCH_TOL L is
 a touching root, so a ray that passes that close to the surface is a hit, as with the
@@ -32,7 +33,8 @@ arguments of log, fractional powers, asin, acos, tan, 1/u and sign are checked i
 their domain on it, by the same enclosures.
 Surfaces with a function that has no interval rule (atan2: range_program raises
 InputError) fall back to the dense search (`dense_first_roots`): F sampled at `samples`
-points, the first sign change bisected, the dips of |F| between samples checked for
+points, the first sign change bisected (a pole when |F| grew under the bisection: then
+the next one), the dips of |F| between samples checked for
 tangential hits. That one is NOT exact: two roots closer than the sample spacing with no
 dip between samples can be missed.
 

@@ -16,7 +16,14 @@ from .. import interval
 from ..errors import InputError
 from ..numeric import evaluate_program
 from ..symbols import POINT
-from .reference_eval import TOUCH_TOL, along_ray, bisection_steps, evaluate_on, point_env
+from .reference_eval import (
+    TOUCH_TOL,
+    along_ray,
+    bisection_steps,
+    derivative_along,
+    evaluate_on,
+    point_env,
+)
 
 # Certified search for non-polynomial surfaces (BISECTION_WIDTH, TOUCH_TOL: reference_eval).
 DEPTH = 40  # leaves are 2^-DEPTH of the chord (~1e-12 for a chord of 3)
@@ -211,7 +218,8 @@ def _node_verdicts(
 ) -> dict[str, np.ndarray]:
     """What each node [s_a, s_b] of ray `ray` is, in batches of CERTIFIED_CHUNK_NODES:
     - "bracket": it holds a root, the first of the node, between its ends of opposite sign:
-      F is monotonic on it (F' excludes 0), or it is a leaf;
+      F is monotonic on it (F' excludes 0), or it is a leaf where F is bounded (a leaf
+      holding a pole, F's enclosure marked unbounded, is dropped: a jump, not a root);
     - "touch": a node without a sign change where |F(mid)| / |grad S| <= TOUCH_TOL L (the
       distance to the surface, to first order): a leaf, or a node dropped by the mean
       value form while F' may vanish on it (a near miss at a tangent: no zero, a dip);
@@ -272,9 +280,11 @@ def _node_verdicts_batch(
             undecided[sub] &= ~(flat_out | monotonic)
             continuous[sub] = ok
             dip[sub] = flat_out & ~steep
-    if leaf:
-        bracket |= undecided & change
-        dip |= undecided
+    if leaf:  # by a pole (F's enclosure marked unbounded) neither a sign change is a root
+        # nor a small |F| / |grad S| (F ~ 1/u: u, the distance to the pole) a touch
+        bounded = ~interval.unbounded(lo, hi)
+        bracket |= undecided & change & bounded
+        dip |= undecided & bounded
         descend = np.zeros(m, dtype=bool)
     else:
         descend = undecided
@@ -288,8 +298,11 @@ def _node_verdicts_batch(
 
 def _touching(programs, gradient, o, d, length, s_a, s_m, s_b, fm, dip) -> np.ndarray:
     """Touching roots among the `dip` nodes: F comes within TOUCH_TOL of 0 at the middle
-    (|F| / |grad S| <= TOUCH_TOL L, the distance to the surface to first order) and F'
-    may vanish on the node (a node on a monotonic stretch near a crossing is not one)."""
+    (|F| / |grad S| <= TOUCH_TOL L, the distance to the surface to first order), F' may
+    vanish on the node (a node on a monotonic stretch near a crossing is not one) and |F|
+    has its dip there: sign(F) F' <= 0 at the start and >= 0 at the end. (Beside a pole,
+    F ~ 1/u, |F| / |grad S| ~ |u| is small too, but |F| grows toward the pole or peaks
+    where the ray passes closest to it: no dip.)"""
     touch = np.zeros(s_a.shape[0], dtype=bool)
     near = np.flatnonzero(dip)
     if not near.size:
@@ -302,6 +315,11 @@ def _touching(programs, gradient, o, d, length, s_a, s_m, s_b, fm, dip) -> np.nd
     if near.size and programs.slope is not None:
         dlo, dhi = _enclosure(programs.slope, o[near], d[near], s_a[near], s_b[near])
         near = near[~((dlo > 0.0) | (dhi < 0.0))]
+    if near.size:
+        side = np.sign(fm[near])
+        down = derivative_along(gradient, o[near], d[near], s_a[near]) * side <= 0.0
+        up = derivative_along(gradient, o[near], d[near], s_b[near]) * side >= 0.0
+        near = near[down & up]
     touch[near] = True
     return touch
 

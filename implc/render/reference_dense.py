@@ -1,7 +1,7 @@
 """The CPU reference's dense search (implc/render/reference.py), for surfaces with a
 function that has no interval rule (atan2): F sampled along each ray, the first sign
-change bisected, the dips of |F| checked for tangential hits. NOT exact: two roots closer
-than the sample spacing with no dip between samples can be missed.
+change that is no pole bisected, the dips of |F| checked for tangential hits. NOT exact:
+two roots closer than the sample spacing with no dip between samples can be missed.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from .reference_eval import (
     TOUCH_TOL,
     along_ray,
     bisection_steps,
+    derivative_along,
     evaluate_on,
     point_env,
 )
@@ -39,7 +40,8 @@ def dense_first_roots(
 
     F is sampled at `samples` uniform points of [t_near, t_far] (both ends included).
     - Crossing: the first interval whose ends have opposite signs (or a sample exactly 0)
-      is bisected to a width of BISECTION_WIDTH.
+      is bisected to a width of BISECTION_WIDTH; where |F| there exceeds |F| at both its
+      samples it was a pole (1/u, tan), no root, and the next such interval is tried.
     - Touching: a sample where |F| is a local minimum without a sign change, and low
       enough that the parabola through its neighbours could reach zero (|F_i| <= 1/4 of
       the second difference; an exact parabola touching zero gives at most 1/8), is
@@ -84,23 +86,38 @@ def _first_crossing(
     values: np.ndarray,
     iterations: int,
 ) -> np.ndarray:
-    """s of the first sign change per ray, bisected; inf where none."""
+    """s of the first sign change per ray that is a root, bisected; inf where none. A sign
+    change through a pole (|F| at the bisected point above |F| at both samples: F grew
+    toward it) is no root, and the next one is tried."""
     left, right = values[:, :-1], values[:, 1:]
-    crossing = (left == 0.0) | (left * right < 0.0)
+    with np.errstate(invalid="ignore"):
+        crossing = (left == 0.0) | (left * right < 0.0)
+    out = np.full(s.shape[0], np.inf)
     rows = np.flatnonzero(crossing.any(axis=1))
-    j = np.argmax(crossing[rows], axis=1)
-    lo, hi = s[rows, j], s[rows, j + 1]
-    f_lo = values[rows, j]
+    while rows.size:
+        j = np.argmax(crossing[rows], axis=1)
+        root = _bisect_crossing(expr, entry[rows], d[rows], s[rows, j], s[rows, j + 1],
+                                values[rows, j], iterations)
+        f_root = along_ray(expr, entry[rows], d[rows], root[:, None])[:, 0]
+        with np.errstate(invalid="ignore"):
+            pole = ~(np.abs(f_root) <= np.maximum(np.abs(values[rows, j]),
+                                                  np.abs(values[rows, j + 1])))
+        out[rows[~pole]] = root[~pole]
+        crossing[rows[pole], j[pole]] = False
+        rows = rows[pole][crossing[rows[pole]].any(axis=1)]
+    return out
+
+
+def _bisect_crossing(expr, entry, d, lo, hi, f_lo, iterations) -> np.ndarray:
+    """The sign change in each [lo, hi] (F = f_lo at lo, 0 there: lo), bisected."""
+    at_lo = f_lo == 0.0
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        f_mid = along_ray(expr, entry[rows], d[rows], mid[:, None])[:, 0]
+        f_mid = along_ray(expr, entry, d, mid[:, None])[:, 0]
         same = f_mid * f_lo > 0.0
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         f_lo = np.where(same, f_mid, f_lo)
-    root = np.where(values[rows, j] == 0.0, s[rows, j], 0.5 * (lo + hi))
-    out = np.full(s.shape[0], np.inf)
-    out[rows] = root
-    return out
+    return np.where(at_lo, lo, 0.5 * (lo + hi))
 
 
 def _first_touch(
@@ -130,7 +147,7 @@ def _first_touch(
     side = np.sign(values[rows, i])  # F' goes from -side to +side across the dip
     for _ in range(iterations):
         half = 0.5 * (lo + hi)
-        slope = _derivative_along(gradient, entry[rows], d[rows], half) * side
+        slope = derivative_along(gradient, entry[rows], d[rows], half) * side
         lo, hi = np.where(slope < 0.0, half, lo), np.where(slope < 0.0, hi, half)
     bottom = 0.5 * (lo + hi)
     points = entry[rows] + bottom[:, None] * d[rows]
@@ -143,11 +160,3 @@ def _first_touch(
     out = np.full(s.shape[0], np.inf)
     np.fmin.at(out, rows, np.where(touches, bottom, np.inf))
     return out
-
-
-def _derivative_along(
-    gradient: Sequence[sympy.Expr], entry: np.ndarray, d: np.ndarray, s: np.ndarray
-) -> np.ndarray:
-    """F'(s) = grad S . D at entry + s d for s of shape (rays,)."""
-    env = point_env(entry + s[:, None] * d)
-    return sum(evaluate_on(g, env, s.shape) * d[:, axis] for axis, g in enumerate(gradient))

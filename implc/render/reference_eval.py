@@ -6,6 +6,7 @@ tangential hit, so that the certified and the dense search judge a root alike.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import sympy
@@ -36,3 +37,11 @@ def point_env(points: np.ndarray) -> dict[sympy.Symbol, np.ndarray]:
 def evaluate_on(expr: sympy.Expr, env: dict[sympy.Symbol, np.ndarray], shape) -> np.ndarray:
     """`evaluate`, broadcast to `shape` (a constant expression evaluates to a scalar)."""
     return np.broadcast_to(evaluate(expr, env), shape)
+
+
+def derivative_along(
+    gradient: Sequence[sympy.Expr], entry: np.ndarray, d: np.ndarray, s: np.ndarray
+) -> np.ndarray:
+    """F'(s) = grad S . D at entry + s d for s of shape (rays,)."""
+    env = point_env(entry + s[:, None] * d)
+    return sum(evaluate_on(g, env, s.shape) * d[:, axis] for axis, g in enumerate(gradient))

@@ -26,6 +26,8 @@ const double STEP = 0.002lf;
 const double TAU1 = 0.01lf;
 const double TAU2 = 0.01lf;
 const double TAU3 = 0.01lf;
+const double ACCEPT = 0.5lf;
+const int CANDIDATES = 16;
 const int MAX_STEPS = 20000;
 const int REFINE_STEPS = 10;
 
@@ -184,6 +186,14 @@ double refine(Ray ray, double a0, double b0, double fa0, double fb) {
 // distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
 // over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
 // float32 t small.
+// A root, not a pole: the refined point is a root only where |F| there is at most ACCEPT
+// times |F| at the step's ends, their geometric mean where F changes sign over the step
+// (toward a root F shrinks, even one near an end; toward a pole, 1/x, it grows) and the
+// smaller one where it does not (a touching root; a Taylor test that fired on a steep F,
+// near a pole or on atan2's undefined axis, refines to no point below both ends), or F is
+// 0 at an end. A rejected step is passed and the march goes on behind it, for at most
+// CANDIDATES candidates in all: each pass marches every lane to its next candidate and
+// refines once, so the refinement runs once per pass, not once per lane-step.
 Hit trace(dvec3 ro, dvec3 rd, double t0, double t1) {
     Ray ray = ray_of(ro, rd, 0.5lf*(t0 + t1), 0.5lf*(t1 - t0));
     double lo = t0 - ray.sm;
@@ -194,24 +204,36 @@ Hit trace(dvec3 ro, dvec3 rd, double t0, double t1) {
     dvec3 f1 = f;
     bool found = false;
     int steps = 0;
-    for (int i = 0; i < MAX_STEPS; ++i) {
-        if (s >= hi) {
+    double t = t1;
+    for (int k = 0; k < CANDIDATES; ++k) {
+        for (int i = 0; i < MAX_STEPS; ++i) {
+            if (s >= hi || steps >= MAX_STEPS) {
+                break;
+            }
+            double st = step_size(ray, s, f);
+            s1 = min(s + st, hi);
+            f1 = values_at(ray, s1, s, min(st, hi - s));
+            steps += 1;
+            if (root_in(f, f1, s1 - s)) {
+                found = true;
+                break;
+            }
+            s = s1;
+            f = f1;
+        }
+        if (!found) {
             break;
         }
-        double st = step_size(ray, s, f);
-        s1 = min(s + st, hi);
-        f1 = values_at(ray, s1, s, min(st, hi - s));
-        steps += 1;
-        if (root_in(f, f1, s1 - s)) {
-            found = true;
+        double r = refine(ray, s, s1, f.x, f1.x);
+        double fa = abs(f.x);
+        double fb = abs(f1.x);
+        if (abs(S(ray.o + r*ray.d)) <= ACCEPT*(f.x*f1.x <= 0.0lf ? sqrt(fa)*sqrt(fb) : min(fa, fb)) || min(fa, fb) == 0.0lf) {
+            t = ray.sm + r;
             break;
         }
+        found = false;
         s = s1;
         f = f1;
-    }
-    double t = t1;
-    if (found) {
-        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return Hit(found, t, steps);
 }

@@ -22,6 +22,8 @@ static const float MITER_STEP = 0.002;
 static const float MITER_TAU1 = 0.01;
 static const float MITER_TAU2 = 0.01;
 static const float MITER_TAU3 = 0.01;
+static const float MITER_ACCEPT = 0.5;
+static const int MITER_CANDIDATES = 16;
 static const int MITER_MAX_STEPS = 20000;
 static const int MITER_REFINE_STEPS = 10;
 
@@ -203,6 +205,14 @@ float miter_refine(miter_Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
 // over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
 // float32 t small.
+// A root, not a pole: the refined point is a root only where |F| there is at most ACCEPT
+// times |F| at the step's ends, their geometric mean where F changes sign over the step
+// (toward a root F shrinks, even one near an end; toward a pole, 1/x, it grows) and the
+// smaller one where it does not (a touching root; a Taylor test that fired on a steep F,
+// near a pole or on atan2's undefined axis, refines to no point below both ends), or F is
+// 0 at an end. A rejected step is passed and the march goes on behind it, for at most
+// CANDIDATES candidates in all: each pass marches every lane to its next candidate and
+// refines once, so the refinement runs once per pass, not once per lane-step.
 miter_Hit miter_trace(float3 ro, float3 rd, float t0, float t1) {
     miter_Ray ray = miter_ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float lo = t0 - ray.sm;
@@ -213,24 +223,36 @@ miter_Hit miter_trace(float3 ro, float3 rd, float t0, float t1) {
     float3 f1 = f;
     bool found = false;
     int steps = 0;
-    for (int i = 0; i < MITER_MAX_STEPS; ++i) {
-        if (s >= hi) {
+    float t = t1;
+    for (int k = 0; k < MITER_CANDIDATES; ++k) {
+        for (int i = 0; i < MITER_MAX_STEPS; ++i) {
+            if (s >= hi || steps >= MITER_MAX_STEPS) {
+                break;
+            }
+            float st = miter_step_size(ray, s, f);
+            s1 = min(s + st, hi);
+            f1 = miter_values_at(ray, s1, s, min(st, hi - s));
+            steps += 1;
+            if (miter_root_in(f, f1, s1 - s)) {
+                found = true;
+                break;
+            }
+            s = s1;
+            f = f1;
+        }
+        if (!found) {
             break;
         }
-        float st = miter_step_size(ray, s, f);
-        s1 = min(s + st, hi);
-        f1 = miter_values_at(ray, s1, s, min(st, hi - s));
-        steps += 1;
-        if (miter_root_in(f, f1, s1 - s)) {
-            found = true;
+        float r = miter_refine(ray, s, s1, f.x, f1.x);
+        float fa = abs(f.x);
+        float fb = abs(f1.x);
+        if (abs(miter_S(ray.o + r*ray.d)) <= MITER_ACCEPT*(f.x*f1.x <= 0.0 ? sqrt(fa)*sqrt(fb) : min(fa, fb)) || min(fa, fb) == 0.0) {
+            t = ray.sm + r;
             break;
         }
+        found = false;
         s = s1;
         f = f1;
-    }
-    float t = t1;
-    if (found) {
-        t = ray.sm + miter_refine(ray, s, s1, f.x, f1.x);
     }
     return miter_Hit_new(found, t, steps);
 }

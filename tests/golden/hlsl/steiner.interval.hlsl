@@ -29,6 +29,7 @@ static const float IV_TINY = 1.1754943508222875e-38;
 static const float START_WIDTH = 0.25;
 static const float MIN_WIDTH = 1.52587890625e-05;
 static const float TOUCH = 1e-07;
+static const float BIG = 1e+30;
 static const int DEPTH = 16;
 static const int MAX_NODES = 1024;
 static const int REFINE_STEPS = 10;
@@ -347,7 +348,8 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // a touching root. Nodes are visited left to right, so the first root ends the walk; the
 // next node follows from pos, width and the node's index (no stack). No sign change of F
 // is missed in a node wider than a leaf (up to the enclosure's widening). `steps` counts
-// the nodes visited.
+// the nodes visited. A leaf holding a pole is passed (F's enclosure is marked [-BIG, BIG]
+// there, implc/interval.py): the walk goes on to the first root behind it.
 Hit trace(float3 ro, float3 rd, float t0, float t1) {
     Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float lo = t0 - ray.sm;
@@ -370,9 +372,12 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
         float2 dr = fd.zw;
         // (an enclosure that overflowed to NaN fails both tests: it is never skipped)
         bool holds = !(r.x > 0.0 || r.y < 0.0);
-        // F is monotonic on the node where its derivative's enclosure excludes 0: a sign
-        // change between its ends is its one root, no sign change none
-        bool monotonic = holds && (dr.x > 0.0 || dr.y < 0.0);
+        // F is bounded on the node unless its enclosure is [-BIG, BIG], the mark of a pole
+        // (1/u, tan) on it: there F may jump through 0, and a sign change is no root
+        bool bounded = !(r.x <= -BIG && r.y >= BIG);
+        // F is monotonic on the node where it is bounded and its derivative's enclosure
+        // excludes 0: a sign change between its ends is its one root, no sign change none
+        bool monotonic = holds && bounded && (dr.x > 0.0 || dr.y < 0.0);
         bool leaf = holds && !monotonic && width <= MIN_WIDTH;
         bool descend = holds && !monotonic && !leaf;
         if (monotonic || leaf) {
@@ -380,7 +385,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
             // either pays for it once)
             float f0 = S(ray.o + na*ray.d);
             float f1 = S(ray.o + nb*ray.d);
-            bool root = f0*f1 <= 0.0;
+            bool root = bounded && f0*f1 <= 0.0;
             if (leaf && !root) {
                 // a leaf that may still hold a root: a touching root where |F| <= TOUCH
                 // at its middle (the refinement's Newton, unbracketed, is clamped to it)

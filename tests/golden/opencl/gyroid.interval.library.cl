@@ -24,6 +24,7 @@ __constant float GYROID_IV_TINY = 1.1754943508222875e-38f;
 __constant float GYROID_START_WIDTH = 0.25f;
 __constant float GYROID_MIN_WIDTH = 1.52587890625e-05f;
 __constant float GYROID_TOUCH = 1e-07f;
+__constant float GYROID_BIG = 1e+30f;
 __constant int GYROID_DEPTH = 16;
 __constant int GYROID_MAX_NODES = 1024;
 __constant int GYROID_REFINE_STEPS = 10;
@@ -369,7 +370,8 @@ float gyroid_refine(gyroid_Ray ray, float a0, float b0, float fa0, float fb) {
 // a touching root. Nodes are visited left to right, so the first root ends the walk; the
 // next node follows from pos, width and the node's index (no stack). No sign change of F
 // is missed in a node wider than a leaf (up to the enclosure's widening). `steps` counts
-// the nodes visited.
+// the nodes visited. A leaf holding a pole is passed (F's enclosure is marked [-BIG, BIG]
+// there, implc/interval.py): the walk goes on to the first root behind it.
 gyroid_Hit gyroid_trace(float3 ro, float3 rd, float t0, float t1) {
     gyroid_Ray ray = gyroid_ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     float lo = t0 - ray.sm;
@@ -392,9 +394,12 @@ gyroid_Hit gyroid_trace(float3 ro, float3 rd, float t0, float t1) {
         float2 dr = fd.zw;
         // (an enclosure that overflowed to NaN fails both tests: it is never skipped)
         bool holds = !(r.x > 0.0f || r.y < 0.0f);
-        // F is monotonic on the node where its derivative's enclosure excludes 0: a sign
-        // change between its ends is its one root, no sign change none
-        bool monotonic = holds && (dr.x > 0.0f || dr.y < 0.0f);
+        // F is bounded on the node unless its enclosure is [-BIG, BIG], the mark of a pole
+        // (1/u, tan) on it: there F may jump through 0, and a sign change is no root
+        bool bounded = !(r.x <= -GYROID_BIG && r.y >= GYROID_BIG);
+        // F is monotonic on the node where it is bounded and its derivative's enclosure
+        // excludes 0: a sign change between its ends is its one root, no sign change none
+        bool monotonic = holds && bounded && (dr.x > 0.0f || dr.y < 0.0f);
         bool leaf = holds && !monotonic && width <= GYROID_MIN_WIDTH;
         bool descend = holds && !monotonic && !leaf;
         if (monotonic || leaf) {
@@ -402,7 +407,7 @@ gyroid_Hit gyroid_trace(float3 ro, float3 rd, float t0, float t1) {
             // either pays for it once)
             float f0 = gyroid_S(ray.o + na*ray.d);
             float f1 = gyroid_S(ray.o + nb*ray.d);
-            bool root = f0*f1 <= 0.0f;
+            bool root = bounded && f0*f1 <= 0.0f;
             if (leaf && !root) {
                 // a leaf that may still hold a root: a touching root where |F| <= TOUCH
                 // at its middle (the refinement's Newton, unbracketed, is clamped to it)

@@ -24,6 +24,8 @@ __constant float STEP = 0.002f;
 __constant float TAU1 = 0.01f;
 __constant float TAU2 = 0.01f;
 __constant float TAU3 = 0.01f;
+__constant float ACCEPT = 0.5f;
+__constant int CANDIDATES = 16;
 __constant int MAX_STEPS = 20000;
 __constant int REFINE_STEPS = 10;
 
@@ -180,6 +182,14 @@ float refine(Ray ray, float a0, float b0, float fa0, float fb) {
 // distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
 // over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
 // float32 t small.
+// A root, not a pole: the refined point is a root only where |F| there is at most ACCEPT
+// times |F| at the step's ends, their geometric mean where F changes sign over the step
+// (toward a root F shrinks, even one near an end; toward a pole, 1/x, it grows) and the
+// smaller one where it does not (a touching root; a Taylor test that fired on a steep F,
+// near a pole or on atan2's undefined axis, refines to no point below both ends), or F is
+// 0 at an end. A rejected step is passed and the march goes on behind it, for at most
+// CANDIDATES candidates in all: each pass marches every lane to its next candidate and
+// refines once, so the refinement runs once per pass, not once per lane-step.
 Hit trace(float3 ro, float3 rd, float t0, float t1) {
     Ray ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     float lo = t0 - ray.sm;
@@ -190,24 +200,36 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     float3 f1 = f;
     bool found = false;
     int steps = 0;
-    for (int i = 0; i < MAX_STEPS; ++i) {
-        if (s >= hi) {
+    float t = t1;
+    for (int k = 0; k < CANDIDATES; ++k) {
+        for (int i = 0; i < MAX_STEPS; ++i) {
+            if (s >= hi || steps >= MAX_STEPS) {
+                break;
+            }
+            float st = step_size(ray, s, f);
+            s1 = min(s + st, hi);
+            f1 = values_at(ray, s1, s, min(st, hi - s));
+            steps += 1;
+            if (root_in(f, f1, s1 - s)) {
+                found = true;
+                break;
+            }
+            s = s1;
+            f = f1;
+        }
+        if (!found) {
             break;
         }
-        float st = step_size(ray, s, f);
-        s1 = min(s + st, hi);
-        f1 = values_at(ray, s1, s, min(st, hi - s));
-        steps += 1;
-        if (root_in(f, f1, s1 - s)) {
-            found = true;
+        float r = refine(ray, s, s1, f.x, f1.x);
+        float fa = fabs(f.x);
+        float fb = fabs(f1.x);
+        if (fabs(S(ray.o + r*ray.d)) <= ACCEPT*(f.x*f1.x <= 0.0f ? sqrt(fa)*sqrt(fb) : min(fa, fb)) || min(fa, fb) == 0.0f) {
+            t = ray.sm + r;
             break;
         }
+        found = false;
         s = s1;
         f = f1;
-    }
-    float t = t1;
-    if (found) {
-        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return (Hit){found, t, steps};
 }

@@ -22,6 +22,7 @@ const GYROID_IV_TINY: f32 = 1.1754943508222875e-38f;
 const GYROID_START_WIDTH: f32 = 0.25f;
 const GYROID_MIN_WIDTH: f32 = 1.52587890625e-05f;
 const GYROID_TOUCH: f32 = 1e-07f;
+const GYROID_BIG: f32 = 1e+30f;
 const GYROID_DEPTH: i32 = 16;
 const GYROID_MAX_NODES: i32 = 1024;
 const GYROID_REFINE_STEPS: i32 = 10;
@@ -367,7 +368,8 @@ fn gyroid_refine(ray: gyroid_Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // a touching root. Nodes are visited left to right, so the first root ends the walk; the
 // next node follows from pos, width and the node's index (no stack). No sign change of F
 // is missed in a node wider than a leaf (up to the enclosure's widening). `steps` counts
-// the nodes visited.
+// the nodes visited. A leaf holding a pole is passed (F's enclosure is marked [-BIG, BIG]
+// there, implc/interval.py): the walk goes on to the first root behind it.
 fn gyroid_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> gyroid_Hit {
     let ray: gyroid_Ray = gyroid_ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     let lo: f32 = t0 - ray.sm;
@@ -390,9 +392,12 @@ fn gyroid_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> gyroid_Hit {
         let dr: vec2<f32> = fd.zw;
         // (an enclosure that overflowed to NaN fails both tests: it is never skipped)
         let holds: bool = !(r.x > 0.0f || r.y < 0.0f);
-        // F is monotonic on the node where its derivative's enclosure excludes 0: a sign
-        // change between its ends is its one root, no sign change none
-        let monotonic: bool = holds && (dr.x > 0.0f || dr.y < 0.0f);
+        // F is bounded on the node unless its enclosure is [-BIG, BIG], the mark of a pole
+        // (1/u, tan) on it: there F may jump through 0, and a sign change is no root
+        let bounded: bool = !(r.x <= -GYROID_BIG && r.y >= GYROID_BIG);
+        // F is monotonic on the node where it is bounded and its derivative's enclosure
+        // excludes 0: a sign change between its ends is its one root, no sign change none
+        let monotonic: bool = holds && bounded && (dr.x > 0.0f || dr.y < 0.0f);
         let leaf: bool = holds && !monotonic && width <= GYROID_MIN_WIDTH;
         let descend: bool = holds && !monotonic && !leaf;
         if (monotonic || leaf) {
@@ -400,7 +405,7 @@ fn gyroid_trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> gyroid_Hit {
             // either pays for it once)
             let f0: f32 = gyroid_S(ray.o + na*ray.d);
             let f1: f32 = gyroid_S(ray.o + nb*ray.d);
-            var root: bool = f0*f1 <= 0.0f;
+            var root: bool = bounded && f0*f1 <= 0.0f;
             if (leaf && !root) {
                 // a leaf that may still hold a root: a touching root where |F| <= TOUCH
                 // at its middle (the refinement's Newton, unbracketed, is clamped to it)

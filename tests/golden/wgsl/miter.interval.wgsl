@@ -34,6 +34,7 @@ const IV_TINY: f32 = 1.1754943508222875e-38f;
 const START_WIDTH: f32 = 0.25f;
 const MIN_WIDTH: f32 = 1.52587890625e-05f;
 const TOUCH: f32 = 1e-07f;
+const BIG: f32 = 1e+30f;
 const DEPTH: i32 = 16;
 const MAX_NODES: i32 = 1024;
 const REFINE_STEPS: i32 = 10;
@@ -324,7 +325,8 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // a touching root. Nodes are visited left to right, so the first root ends the walk; the
 // next node follows from pos, width and the node's index (no stack). No sign change of F
 // is missed in a node wider than a leaf (up to the enclosure's widening). `steps` counts
-// the nodes visited.
+// the nodes visited. A leaf holding a pole is passed (F's enclosure is marked [-BIG, BIG]
+// there, implc/interval.py): the walk goes on to the first root behind it.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     let lo: f32 = t0 - ray.sm;
@@ -347,9 +349,12 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
         let dr: vec2<f32> = fd.zw;
         // (an enclosure that overflowed to NaN fails both tests: it is never skipped)
         let holds: bool = !(r.x > 0.0f || r.y < 0.0f);
-        // F is monotonic on the node where its derivative's enclosure excludes 0: a sign
-        // change between its ends is its one root, no sign change none
-        let monotonic: bool = holds && (dr.x > 0.0f || dr.y < 0.0f);
+        // F is bounded on the node unless its enclosure is [-BIG, BIG], the mark of a pole
+        // (1/u, tan) on it: there F may jump through 0, and a sign change is no root
+        let bounded: bool = !(r.x <= -BIG && r.y >= BIG);
+        // F is monotonic on the node where it is bounded and its derivative's enclosure
+        // excludes 0: a sign change between its ends is its one root, no sign change none
+        let monotonic: bool = holds && bounded && (dr.x > 0.0f || dr.y < 0.0f);
         let leaf: bool = holds && !monotonic && width <= MIN_WIDTH;
         let descend: bool = holds && !monotonic && !leaf;
         if (monotonic || leaf) {
@@ -357,7 +362,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             // either pays for it once)
             let f0: f32 = S(ray.o + na*ray.d);
             let f1: f32 = S(ray.o + nb*ray.d);
-            var root: bool = f0*f1 <= 0.0f;
+            var root: bool = bounded && f0*f1 <= 0.0f;
             if (leaf && !root) {
                 // a leaf that may still hold a root: a touching root where |F| <= TOUCH
                 // at its middle (the refinement's Newton, unbracketed, is clamped to it)

@@ -34,6 +34,8 @@ const TAU1: f32 = 0.01f;
 const TAU2: f32 = 0.01f;
 const TAU3: f32 = 0.01f;
 const EPS: f32 = 0.001f;
+const ACCEPT: f32 = 0.5f;
+const CANDIDATES: i32 = 16;
 const MAX_STEPS: i32 = 20000;
 const REFINE_STEPS: i32 = 10;
 
@@ -185,6 +187,14 @@ fn refine(ray: Ray, a0: f32, b0: f32, fa0: f32, fb: f32) -> f32 {
 // distinct step at which one of its lanes finds a root.) The march runs in s = t - sm,
 // over [lo, hi]. Start the ray near the surface (e.g. at its clip-sphere entry) to keep
 // float32 t small.
+// A root, not a pole: the refined point is a root only where |F| there is at most ACCEPT
+// times |F| at the step's ends, their geometric mean where F changes sign over the step
+// (toward a root F shrinks, even one near an end; toward a pole, 1/x, it grows) and the
+// smaller one where it does not (a touching root; a Taylor test that fired on a steep F,
+// near a pole or on atan2's undefined axis, refines to no point below both ends), or F is
+// 0 at an end. A rejected step is passed and the march goes on behind it, for at most
+// CANDIDATES candidates in all: each pass marches every lane to its next candidate and
+// refines once, so the refinement runs once per pass, not once per lane-step.
 fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     let lo: f32 = t0 - ray.sm;
@@ -195,24 +205,36 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     var f1: vec3<f32> = f;
     var found: bool = false;
     var steps: i32 = 0;
-    for (var i: i32 = 0; i < MAX_STEPS; i++) {
-        if (s >= hi) {
+    var t: f32 = t1;
+    for (var k: i32 = 0; k < CANDIDATES; k++) {
+        for (var i: i32 = 0; i < MAX_STEPS; i++) {
+            if (s >= hi || steps >= MAX_STEPS) {
+                break;
+            }
+            let st: f32 = step_size(ray, s, f);
+            s1 = min(s + st, hi);
+            f1 = values_at(ray, s1, s, min(st, hi - s));
+            steps += 1;
+            if (root_in(f, f1, s1 - s)) {
+                found = true;
+                break;
+            }
+            s = s1;
+            f = f1;
+        }
+        if (!found) {
             break;
         }
-        let st: f32 = step_size(ray, s, f);
-        s1 = min(s + st, hi);
-        f1 = values_at(ray, s1, s, min(st, hi - s));
-        steps += 1;
-        if (root_in(f, f1, s1 - s)) {
-            found = true;
+        let r: f32 = refine(ray, s, s1, f.x, f1.x);
+        let fa: f32 = abs(f.x);
+        let fb: f32 = abs(f1.x);
+        if (abs(S(ray.o + r*ray.d)) <= ACCEPT*select(min(fa, fb), sqrt(fa)*sqrt(fb), f.x*f1.x <= 0.0f) || min(fa, fb) == 0.0f) {
+            t = ray.sm + r;
             break;
         }
+        found = false;
         s = s1;
         f = f1;
-    }
-    var t: f32 = t1;
-    if (found) {
-        t = ray.sm + refine(ray, s, s1, f.x, f1.x);
     }
     return Hit(found, t, steps);
 }
