@@ -165,12 +165,15 @@ def compile_shader(
     precision: str | None = None,
     evaluation: str | None = None,
     params: str = "constant",
+    static_params: bool = False,
 ) -> CompiledShader:
     """The shader for `surface` (its text deterministic, byte for byte) and what was
     decided on the way.
 
     `params`: "constant" bakes the parameters' values into the expressions; "uniform"
-    keeps them as uniforms the host sets at run time (`param_uniforms`)."""
+    keeps them as uniforms the host sets at run time (`param_uniforms`), or, with
+    `static_params` (a host's node function that takes them as inputs: implc/hosts.py),
+    as globals that function sets before its calls (HLSL's `static`)."""
     check_shader_options(target, flavor, precision, prefix, emit_form, params)
     tgt = get_target(target)
     meth = get_method(method)
@@ -219,6 +222,7 @@ def compile_shader(
         "flavor": tgt.flavors[flavor],
         "flavor_name": flavor,
         "precision": precision,
+        "static_params": static_params,
         "shading": print_shading(surface.view, shade_printer),
         "view": _print_view(surface.view, shade_printer),
     }

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
 
     from ..scene import Framing, View
     from ..surface import Surface as SurfaceRecord
+    from .exporting import HostFiles
     from .records import Rendering, Shader
     from .widget import Viewer
 
@@ -204,6 +205,16 @@ class Surface:
         return compile_surface(self, target, method, emit=emit, prefix=prefix,
                                flavor=flavor, precision=precision, params=params,
                                constants=constants)
+
+    def export(self, host: str, method: str | None = None, *, precision: str | None = None,
+               prefix: str | None = None, **constants: Any) -> HostFiles:
+        """The files `host` loads (see `implc.HOSTS`: three, unity, ...), the parameters as
+        its own controls and how to use them at the top; `.save(directory)` writes them."""
+        from .exporting import export_surface
+
+        return export_surface(self, host, method, precision=precision, prefix=prefix,
+                              command=f"implc export {self.name!r} --host {host}",
+                              constants=constants)
 
     def render(self, size: int = 512, *, width: int | None = None,
                height: int | None = None, backend: str | None = None,

@@ -25,6 +25,7 @@ from .cmd_bench import run as cmd_bench
 from .cmd_compare import run as cmd_compare
 from .cmd_compile import run as cmd_compile
 from .cmd_corpus import run as cmd_corpus
+from .cmd_export import run as cmd_export
 from .cmd_gallery import run as cmd_gallery
 from .cmd_list import run as cmd_list
 from .cmd_render import run as cmd_render
@@ -76,6 +77,6 @@ def _run(args: argparse.Namespace) -> int:
 
 __all__ = [
     "LIMIT_FLAGS", "UsageError", "build_parser", "cmd_bench", "cmd_compare", "cmd_compile",
-    "cmd_corpus", "cmd_gallery", "cmd_list", "cmd_render", "cmd_show", "cmd_validate",
+    "cmd_corpus", "cmd_export", "cmd_gallery", "cmd_list", "cmd_render", "cmd_show", "cmd_validate",
     "cmd_view", "main",
 ]

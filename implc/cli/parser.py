@@ -73,6 +73,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .cmd_compare import add_parser as add_compare
     from .cmd_compile import add_parser as add_compile
     from .cmd_corpus import add_parser as add_corpus
+    from .cmd_export import add_parser as add_export
     from .cmd_gallery import add_parser as add_gallery
     from .cmd_list import add_parser as add_list
     from .cmd_render import add_parser as add_render
@@ -88,8 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"implc {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for add in (add_list, add_show, add_compile, add_validate, add_render, add_view,
-                add_compare, add_bench, add_corpus, add_gallery):
+    for add in (add_list, add_show, add_compile, add_export, add_validate, add_render,
+                add_view, add_compare, add_bench, add_corpus, add_gallery):
         add(sub)
     return parser
 

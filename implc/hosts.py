@@ -1,0 +1,71 @@
+"""THE host registry: one record per engine or tool that drop-in shaders are pasted into
+(three.js, Unity, Unreal, Godot, ISF hosts, WESL packages), read by `implc export`, the
+API's `Surface.export` and the tests.
+
+A host is data, like a target (implc/targets.py): the shaders it needs (a target and a
+flavour each, always the library emit with the parameters as uniforms, so that they can
+become the host's own controls), the files it loads (a name pattern and a template under
+templates/hosts/<name>/), and what it cannot take. implc/export.py compiles the shaders
+and renders the files; nothing else branches on a host's name. Adding a host is one
+record here, its templates, its test and its README section (README "Hosts").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class HostShader:
+    """One library emit a host's files include, read by the templates as shaders[key]."""
+
+    key: str  # the name its templates read it by
+    target: str  # implc/targets.py
+    flavor: str | None = None  # the target's flavour (None: its default)
+    # the parameters as globals the host's function sets (its node's inputs) rather than
+    # uniforms the host binds (emit.compile_shader's static_params)
+    static_params: bool = False
+
+
+@dataclass(frozen=True)
+class Host:
+    name: str
+    about: str  # one line for `implc export --help`
+    shaders: tuple[HostShader, ...]
+    # file name pattern ({stem}: the surface's name as an identifier) -> its template
+    # under templates/ (what the host loads; the first is the main one)
+    files: Mapping[str, str]
+    precisions: tuple[str, ...] = ("float",)  # what its shading language can solve in
+    # why a precision the host lacks is refused (the message's reason)
+    precision_reason: str = "the host's shading language has no double"
+    # a prefix for the library's global names when the caller gives none ({stem}_)
+    prefix: str = "{stem}_"
+    # how a name is spelled for the host's files: "snake" (my_surface) or "pascal"
+    # (MySurface, Unity's and Unreal's custom nodes)
+    stem_case: str = "snake"
+    extras: Mapping[str, object] = field(default_factory=dict)  # what its templates read
+
+
+HOSTS: dict[str, Host] = {host.name: host for host in (
+    Host(
+        name="unity",
+        about="Unity Shader Graph: a Custom Function node's .hlsl file",
+        shaders=(HostShader("hlsl", "hlsl", static_params=True),),
+        files={"{stem}.hlsl": "hosts/unity/custom_function.hlsl.j2"},
+        stem_case="pascal",
+    ),
+)}
+
+
+def get_host(name: str) -> Host:
+    """The record of `name`; an unknown name raises ValueError with a did-you-mean."""
+    try:
+        return HOSTS[name]
+    except KeyError:
+        import difflib
+
+        close = difflib.get_close_matches(name, list(HOSTS), n=1, cutoff=0.6)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
+        raise ValueError(f"unknown host '{name}'{hint} (choose from "
+                         f"{', '.join(HOSTS)})") from None
