@@ -16,6 +16,7 @@ the README's figure is made by `make three-picture` (IMPLC_SCREENSHOTS=docs).
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -159,3 +160,26 @@ def test_the_three_module_is_pinned_three_that_exports_both_renderers():
     tsl = (build / "three.tsl.js").read_text()
     for name in ("wgslFn", "glslFn", "colorSpaceToWorking", "viewZToPerspectiveDepth"):
         assert f"const {name} = " in tsl
+
+
+def module_strings(text: str) -> dict[str, str]:
+    """The module's shader strings (`const NAME = `...`;`), unescaped."""
+    found = re.findall(r"^const ([A-Z_]+) = `(.*?)`;$", text, flags=re.S | re.M)
+    return {name: body.replace("\\`", "`").replace("\\${", "${").replace("\\\\", "\\")
+            for name, body in found}
+
+
+@pytest.mark.parametrize("target", ["glsl", "wgsl"])
+def test_the_modules_libraries_and_trace_compile_without_a_browser(target):
+    """What wgslFn and glslFn get (the library and the trace function), as the module holds
+    it, compiles with implc's own validator of the language (glslang, naga)."""
+    from conftest import require_validator
+
+    validate = require_validator(target)
+    module = api.Surface.example("torus").export("three").main
+    strings = module_strings(module)
+    assert set(strings) == {"GLSL_LIBRARY", "WGSL_LIBRARY", "GLSL_TRACE", "WGSL_TRACE",
+                            "VERTEX_SHADER"}
+    text = strings[f"{target.upper()}_LIBRARY"] + strings[f"{target.upper()}_TRACE"]
+    verdict = validate(text, f"torus.{target}")
+    assert verdict.ok, verdict.messages
