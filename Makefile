@@ -146,5 +146,9 @@ gallery-pictures: setup
 notebook-picture: setup
 	IMPLC_SCREENSHOTS=docs $(PY) -m pytest tests/test_jupyterlab.py -q
 
+.PHONY: three-picture
+three-picture: setup
+	IMPLC_SCREENSHOTS=docs $(PY) -m pytest tests/test_host_three.py -q -k "torus and webgpu and not webgl2"
+
 clean:
 	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules

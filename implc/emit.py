@@ -173,7 +173,8 @@ def compile_shader(
     `params`: "constant" bakes the parameters' values into the expressions; "uniform"
     keeps them as uniforms the host sets at run time (`param_uniforms`), or, with
     `static_params` (a host's node function that takes them as inputs: implc/hosts.py),
-    as globals that function sets before its calls (HLSL's `static`)."""
+    as globals that function sets before its calls (HLSL's `static`, GLSL's plain
+    globals)."""
     check_shader_options(target, flavor, precision, prefix, emit_form, params)
     tgt = get_target(target)
     meth = get_method(method)

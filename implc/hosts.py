@@ -49,6 +49,16 @@ class Host:
 
 HOSTS: dict[str, Host] = {host.name: host for host in (
     Host(
+        name="three",
+        about="three.js: an ES module for WebGLRenderer and WebGPURenderer (TSL)",
+        # GLSL first: the controls' uniform names are its globals'. Its parameters are
+        # globals the trace function sets: three binds no uniform a glslFn include declares
+        shaders=(HostShader("glsl", "glsl", "es300", static_params=True),
+                 HostShader("wgsl", "wgsl")),
+        files={"{stem}.js": "hosts/three/module.js.j2"},
+        precision_reason="WebGL2 and WebGPU shaders have no double",
+    ),
+    Host(
         name="unity",
         about="Unity Shader Graph: a Custom Function node's .hlsl file",
         shaders=(HostShader("hlsl", "hlsl", static_params=True),),
