@@ -55,6 +55,15 @@ HOSTS: dict[str, Host] = {host.name: host for host in (
         files={"{stem}.hlsl": "hosts/unity/custom_function.hlsl.j2"},
         stem_case="pascal",
     ),
+    Host(
+        name="unreal",
+        about="Unreal Engine material: a Custom node's Code and the .ush it includes",
+        shaders=(HostShader("hlsl", "hlsl", static_params=True),),
+        # the node's Code first: it says how to set the node up
+        files={"{stem}_CustomNode.hlsl": "hosts/unreal/custom_node.hlsl.j2",
+               "{stem}.ush": "hosts/unreal/library.ush.j2"},
+        stem_case="pascal",
+    ),
 )}
 
 
