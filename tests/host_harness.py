@@ -50,6 +50,7 @@ def harness(host: str, node_file: Path, stem: str, controls: Sequence[ParamUnifo
     """The harness's HLSL text; `node_file` is #included, `body` is a node's Code;
     `controls`: the surface's parameters, the node's inputs in their order."""
     return render_template(f"hosts/{host}/harness.hlsl.j2", file=node_file.name, stem=stem,
+                           extras=HOSTS[host].extras,
                            controls=controls, body=body, real=real,
                            background=SHADING.background)
 
@@ -83,10 +84,11 @@ def compile_front(front: str, text: str, directory: Path) -> None:
         compile_glslang(source, directory / "harness_glslang.spv")
 
 
-def exported(host: str, directory: Path, example: str,
+def exported(host: str, directory: Path, example: str | Surface,
              method: str = "hessian") -> tuple[dict[str, str], Surface]:
-    """`host`'s files for a bundled example, written into `directory`, and the surface."""
-    surface = load_surface(example)
+    """`host`'s files for a bundled example (or a framed surface), written into
+    `directory`, and the surface."""
+    surface = load_surface(example) if isinstance(example, str) else example
     files = export_files(surface, HOSTS[host], method, METHODS[method].defaults)
     for name, text in files.items():
         (directory / name).write_text(text)
@@ -168,3 +170,12 @@ def renders_like_implc(text: str, directory: Path, front: str, surface: Surface,
     runner.set_params(moved)
     assert_same(got_moved, run_frame(runner, 0.0), f"  moved {moved}")
     assert np.mean(got_moved.hit != got.hit) > 0.01  # the input did move the picture
+
+
+def clashing_surface() -> Surface:
+    """A sphere whose parameters are called as a node's own names and HLSL keywords:
+    the nodes take them as T_in, out_in, t_in (templates/hosts/node_inputs.j2)."""
+    import implc as api
+
+    return api.Surface("x^2+y^2+z^2 - t*out - T", params={"t": 1, "out": 0.5, "T": 0.2},
+                       name="clash").framed()[0]

@@ -10,7 +10,14 @@ from __future__ import annotations
 
 import pytest
 from conftest import require_tool
-from host_harness import FRONT_ENDS, compile_front, exported, harness, renders_like_implc
+from host_harness import (
+    FRONT_ENDS,
+    clashing_surface,
+    compile_front,
+    exported,
+    harness,
+    renders_like_implc,
+)
 
 from implc.emit import param_uniforms
 
@@ -52,3 +59,16 @@ def test_the_half_function_renders_like_implc(tmp_path):
     text = harness("unity", tmp_path / name, name.removesuffix(".hlsl"), controls,
                    real="half")
     renders_like_implc(text, tmp_path, "glslang", surface, controls, "unity torus, _half")
+
+
+def test_parameters_named_as_the_nodes_own_names_are_renamed_inputs(tmp_path):
+    """Parameters t, out and T (a local, an HLSL keyword, an output) are inputs t_in,
+    out_in and T_in, and each reaches its own parameter (the last, t, moved)."""
+    surface = clashing_surface()
+    files, _ = exported("unity", tmp_path, surface)
+    (name,) = files
+    head = "\n".join(files[name].splitlines()[:30])
+    assert all(f"{p}_in (Float: the parameter {p};" in head for p in ("t", "out", "T"))
+    controls = param_uniforms(surface, "hlsl", "library")
+    text = harness("unity", tmp_path / name, name.removesuffix(".hlsl"), controls)
+    renders_like_implc(text, tmp_path, "glslang", surface, controls, "unity clash")

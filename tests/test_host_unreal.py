@@ -11,7 +11,14 @@ from __future__ import annotations
 
 import pytest
 from conftest import require_tool
-from host_harness import FRONT_ENDS, compile_front, exported, harness, renders_like_implc
+from host_harness import (
+    FRONT_ENDS,
+    clashing_surface,
+    compile_front,
+    exported,
+    harness,
+    renders_like_implc,
+)
 
 from implc.emit import param_uniforms
 
@@ -43,3 +50,16 @@ def test_the_custom_node_renders_like_implc(tmp_path, front, example):
     text, surface, controls = unreal_harness(tmp_path, example)
     renders_like_implc(text, tmp_path, front, surface, controls, f"unreal {example}",
                        SHOT if front == "glslang" and example == "torus" else "")
+
+
+def test_parameters_named_as_the_nodes_own_names_are_renamed_inputs(tmp_path):
+    """Parameters t, out and T (a local, an HLSL keyword, an output) are the Custom
+    node's inputs t_in, out_in and T_in, each reaching its own parameter."""
+    surface = clashing_surface()
+    files, _ = exported("unreal", tmp_path, surface)
+    code, ush = files
+    assert files[code].rstrip().endswith("TNear, TFar, T_in, out_in, t_in, Hit, T, Normal);")
+    controls = param_uniforms(surface, "hlsl", "library")
+    text = harness("unreal", tmp_path / ush, ush.removesuffix(".ush"), controls,
+                   body=files[code])
+    renders_like_implc(text, tmp_path, "glslang", surface, controls, "unreal clash")
