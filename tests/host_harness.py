@@ -30,6 +30,7 @@ from implc.scene import SHADING, View
 from implc.surface import Surface
 
 FRONT_ENDS = ("glslang", "slang")
+T_FAR = "TFar"  # the node's TFar in render_harness's values (1e6 unless given)
 
 
 def slangc() -> str:
@@ -99,7 +100,8 @@ def render_harness(text: str, directory: Path, front: str, view: View,
                    controls: Sequence[ParamUniform], size: int,
                    values: Mapping[str, float] | None = None) -> RenderResult:
     """The harness (its node files in `directory`) compiled by `front` and drawn, with
-    the parameters (the node's inputs) at `values` where given, else the surface's."""
+    the parameters (the node's inputs) and TFar (T_FAR) at `values` where given, else the
+    surface's and 1e6."""
     source = directory / f"harness_{front}.hlsl"
     source.write_text(text)
     if front == "glslang":
@@ -110,6 +112,7 @@ def render_harness(text: str, directory: Path, front: str, view: View,
         fragment = spirv_to_glsl(str(spirv))
     params = [ParamUniform(c.name, f"in_{i}", f"in_{i}", c.value)
               for i, c in enumerate(controls)]
+    params.append(ParamUniform(T_FAR, "u_t_far", "u_t_far", 1.0e6))
     vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
     runner = HlslRunner(fragment, vertex, view, size, size, params)
     try:
@@ -170,6 +173,26 @@ def renders_like_implc(text: str, directory: Path, front: str, surface: Surface,
     runner.set_params(moved)
     assert_same(got_moved, run_frame(runner, 0.0), f"  moved {moved}")
     assert np.mean(got_moved.hit != got.hit) > 0.01  # the input did move the picture
+
+
+def honours_t_far(text: str, directory: Path, surface: Surface,
+                  controls: Sequence[ParamUniform], label: str, size: int = 128) -> None:
+    """TFar at the median hit's t (a scene depth): the node hits where implc's t is
+    nearer, with implc's t, and misses where it is farther (pixels within 1e-3 of TFar
+    not judged)."""
+    require_gl()
+    full = render_harness(text, directory, "glslang", surface.view, controls, size)
+    depth = float(np.median(full.t[full.hit]))
+    cut = render_harness(text, directory, "glslang", surface.view, controls, size,
+                         {T_FAR: depth})
+    judged = np.abs(full.t - depth) > 1e-3
+    expected = full.hit & (full.t < depth)
+    agree = float(np.mean((cut.hit == expected)[judged]))
+    print(f"{label}: TFar {depth:.4f}: {cut.hit.mean():.3f} of the pixels hit "
+          f"(uncut {full.hit.mean():.3f}), agreement {agree:.5f}")
+    assert agree == 1.0 and 0.1 < cut.hit.mean() < full.hit.mean() - 0.1
+    both = cut.hit & judged  # the march starts elsewhere on a shorter segment: t to T_CLOSE
+    assert float(np.max(np.abs(cut.t[both] - full.t[both]))) < T_CLOSE
 
 
 def clashing_surface() -> Surface:

@@ -16,6 +16,7 @@ from host_harness import (
     compile_front,
     exported,
     harness,
+    honours_t_far,
     renders_like_implc,
 )
 
@@ -72,3 +73,12 @@ def test_parameters_named_as_the_nodes_own_names_are_renamed_inputs(tmp_path):
     controls = param_uniforms(surface, "hlsl", "library")
     text = harness("unity", tmp_path / name, name.removesuffix(".hlsl"), controls)
     renders_like_implc(text, tmp_path, "glslang", surface, controls, "unity clash")
+
+
+def test_the_node_searches_no_farther_than_tfar(tmp_path):
+    """TFar (e.g. the scene depth) cuts the search: nearer hits stay, farther ones go."""
+    files, surface = exported("unity", tmp_path, "torus")
+    (name,) = files
+    controls = param_uniforms(surface, "hlsl", "library")
+    text = harness("unity", tmp_path / name, name.removesuffix(".hlsl"), controls)
+    honours_t_far(text, tmp_path, surface, controls, "unity torus")

@@ -17,6 +17,7 @@ from host_harness import (
     compile_front,
     exported,
     harness,
+    honours_t_far,
     renders_like_implc,
 )
 
@@ -63,3 +64,9 @@ def test_parameters_named_as_the_nodes_own_names_are_renamed_inputs(tmp_path):
     text = harness("unreal", tmp_path / ush, ush.removesuffix(".ush"), controls,
                    body=files[code])
     renders_like_implc(text, tmp_path, "glslang", surface, controls, "unreal clash")
+
+
+def test_the_custom_node_searches_no_farther_than_tfar(tmp_path):
+    """TFar (e.g. the scene depth) cuts the search: nearer hits stay, farther ones go."""
+    text, surface, controls = unreal_harness(tmp_path, "torus")
+    honours_t_far(text, tmp_path, surface, controls, "unreal torus")
