@@ -15,6 +15,10 @@ APT_PACKAGES := glslang-tools spirv-cross libegl1 libegl-mesa0 libgl1-mesa-dri m
 NPM_DIR := tests/browser
 NPM_STAMP := $(NPM_DIR)/node_modules/.implc-installed
 VIEW_SURFACE := torus
+# Slang's compiler (slangc), the second HLSL front end of the Unity and Unreal host tests
+# (tests/host_harness.py): the slangtorch wheel ships it, installed with --no-deps (its
+# torch is not needed for the compiler).
+SLANGTORCH := 1.3.22
 
 .PHONY: setup demo view test golden lint bench bench-baseline forms clean system-packages fuzz corpus \
   compile-times startup
@@ -35,6 +39,7 @@ $(STAMP): pyproject.toml
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test,plots]'
+	$(PY) -m pip install -q --no-deps 'slangtorch==$(SLANGTORCH)'
 	touch $(STAMP)
 
 $(NPM_STAMP): $(NPM_DIR)/package.json $(NPM_DIR)/package-lock.json

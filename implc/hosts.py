@@ -47,6 +47,22 @@ class Host:
     extras: Mapping[str, object] = field(default_factory=dict)  # what its templates read
 
 
+# HLSL's keywords and type names that a parameter could be called: a node's input, named
+# after its parameter, takes NAME_in instead of one of these or of the node's own names
+# (its "reserved" extra, read by templates/hosts/node_inputs.j2)
+HLSL_KEYWORDS = frozenset((
+    "in", "out", "inout", "uniform", "static", "const", "extern", "shared", "groupshared",
+    "volatile", "precise", "inline", "float", "half", "double", "int", "uint", "bool", "dword",
+    "min16float", "min10float", "min16int", "min12int", "min16uint", "void", "vector",
+    "matrix", "string", "struct", "class", "interface", "namespace", "typedef", "register",
+    "packoffset", "cbuffer", "tbuffer", "texture", "sampler", "true", "false", "return", "if",
+    "else", "for", "while", "do", "break", "continue", "discard", "switch", "case", "default",
+    "linear", "centroid", "nointerpolation", "noperspective", "sample", "point", "line",
+    "triangle", "lineadj", "triangleadj", "row_major", "column_major", "snorm", "unorm",
+    "compile", "pass", "technique", "unsigned", "export",
+))
+
+
 HOSTS: dict[str, Host] = {host.name: host for host in (
     Host(
         name="three",
@@ -64,6 +80,22 @@ HOSTS: dict[str, Host] = {host.name: host for host in (
         shaders=(HostShader("hlsl", "hlsl", static_params=True),),
         files={"{stem}.hlsl": "hosts/unity/custom_function.hlsl.j2"},
         stem_case="pascal",
+        extras={"reserved": HLSL_KEYWORDS | {
+            "RayOrigin", "RayDirection", "TNear", "TFar", "Hit", "T", "Normal", "Color",
+            "t", "normal", "color", "g"}},
+    ),
+    Host(
+        name="unreal",
+        about="Unreal Engine material: a Custom node's Code and the .ush it includes",
+        shaders=(HostShader("hlsl", "hlsl", static_params=True),),
+        # the node's Code first: it says how to set the node up
+        files={"{stem}_CustomNode.hlsl": "hosts/unreal/custom_node.hlsl.j2",
+               "{stem}.ush": "hosts/unreal/library.ush.j2"},
+        stem_case="pascal",
+        extras={"reserved": HLSL_KEYWORDS | {
+            "RayOrigin", "RayDirection", "TNear", "TFar", "Hit", "T", "Normal", "Parameters",
+            "t", "hit", "g", "MaterialFloat", "MaterialFloat2", "MaterialFloat3",
+            "MaterialFloat4"}},
     ),
 )}
 

@@ -19,6 +19,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -43,23 +44,36 @@ def toolchain() -> tuple[str, ...]:
     return paths  # type: ignore[return-value]
 
 
-def hlsl_to_glsl(hlsl: str) -> str:
-    """HLSL pixel shader (entry point main) -> SPIR-V -> GLSL 330 core with plain uniforms."""
-    glslang, cross = toolchain()[:2]
+def hlsl_to_glsl(hlsl: str, include_dirs: Sequence[str] = ()) -> str:
+    """HLSL pixel shader (entry point main) -> SPIR-V -> GLSL 330 core with plain uniforms
+    (`include_dirs`: where its #include files are, as glslang's -I)."""
+    glslang = toolchain()[0]
     with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
         source, spirv = os.path.join(tmp, "shader.hlsl"), os.path.join(tmp, "shader.spv")
         Path(source).write_text(hlsl, encoding="utf-8")
-        for command in ([glslang, "-D", "-S", "frag", "-e", "main", "-V", "-o", spirv, source],
-                        [cross, "--version", "330", "--no-es",
-                         "--glsl-emit-ubo-as-plain-uniforms", spirv]):
-            try:
-                proc = subprocess.run(command, capture_output=True, text=True, timeout=120)
-            except subprocess.TimeoutExpired:
-                raise ToolError(f"{Path(command[0]).name} did not finish within 120 s") from None
-            if proc.returncode != 0:
-                raise ToolError(f"{Path(command[0]).name} rejected the shader:\n"
-                                f"{(proc.stdout + proc.stderr).strip()}")
-    return plain_uniforms(proc.stdout)
+        _run([glslang, "-D", "-S", "frag", "-e", "main", "-V",
+              *(f"-I{d}" for d in include_dirs), "-o", spirv, source])
+        return spirv_to_glsl(spirv)
+
+
+def spirv_to_glsl(spirv: str) -> str:
+    """A SPIR-V pixel shader's file (any HLSL front end's output) -> GLSL 330 core with
+    plain uniforms."""
+    cross = toolchain()[1]
+    return plain_uniforms(_run([cross, "--version", "330", "--no-es",
+                                "--glsl-emit-ubo-as-plain-uniforms", spirv]))
+
+
+def _run(command: list[str]) -> str:
+    """The tool's standard output; a ToolError with its messages if it fails."""
+    try:
+        proc = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    except subprocess.TimeoutExpired:
+        raise ToolError(f"{Path(command[0]).name} did not finish within 120 s") from None
+    if proc.returncode != 0:
+        raise ToolError(f"{Path(command[0]).name} rejected the shader:\n"
+                        f"{(proc.stdout + proc.stderr).strip()}")
+    return proc.stdout
 
 
 def plain_uniforms(glsl: str) -> str:
