@@ -277,15 +277,20 @@ def _t_poly(node: sympy.Basic, parts: list[list[Fraction]],
             result = _times(result, part)
         return result
     if node.is_Pow and node.exp.is_Integer and node.exp >= 0:
-        result, base, n = [Fraction(1)], parts[0], int(node.exp)
-        while n:  # by squaring
-            if n & 1:
-                result = _times(result, base)
-            n >>= 1
-            if n:
-                base = _times(base, base)
-        return result
+        return _power(parts[0], int(node.exp), _times, [Fraction(1)])
     raise ValueError(f"not a polynomial node: {node}")  # is_polynomial said it is
+
+
+def _power(base: T, n: int, times: Callable[[T, T], T], one: T) -> T:
+    """base^n by squaring, in the arithmetic `times` (one: its unit)."""
+    result = one
+    while n:
+        if n & 1:
+            result = times(result, base)
+        n >>= 1
+        if n:
+            base = times(base, base)
+    return result
 
 
 def _constant(node: sympy.Basic) -> Fraction:
@@ -339,14 +344,7 @@ def expanded_terms(expr: sympy.Expr) -> dict[tuple[int, int, int], sympy.Expr]:
                 result = _poly_product(result, part)
             return result
         if node.is_Pow and node.exp.is_Integer and node.exp >= 0:
-            result, base, n = {(0, 0, 0): sympy.S.One}, parts[0], int(node.exp)
-            while n:  # by squaring
-                if n & 1:
-                    result = _poly_product(result, base)
-                n >>= 1
-                if n:
-                    base = _poly_product(base, base)
-            return result
+            return _power(parts[0], int(node.exp), _poly_product, {(0, 0, 0): sympy.S.One})
         raise ValueError(f"not a polynomial node: {node}")
 
     return fold_tree(expr, combine)
