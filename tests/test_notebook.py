@@ -3,10 +3,10 @@ tour notebook run by a real kernel (nbclient + ipykernel), and the cost of the f
 inline picture in a fresh kernel.
 
 The tour must run without an error and its outputs must hold a PNG and the widget's model
-(application/vnd.jupyter.widget-view+json). The first picture's bar: issue 45's target is
+(application/vnd.jupyter.widget-view+json). The first picture's cost (issue 45's target:
 <= 3 s for `import implc` and the Cross-Cap's inline picture in a fresh kernel; measured
-0.8-1.8 s here (2 shared cores, llvmpipe), so the test fails above twice the target (a
-regression, not load noise) and prints the numbers.
+0.8-1.8 s here, 2 shared cores, llvmpipe) is printed, never asserted: a test must pass on
+a slow or busy machine.
 """
 
 from __future__ import annotations
@@ -24,7 +24,6 @@ import implc
 ROOT = Path(__file__).resolve().parent.parent
 TOUR = ROOT / "examples" / "notebooks" / "tour.ipynb"
 WIDGET_MIME = "application/vnd.jupyter.widget-view+json"
-FIRST_PICTURE_BAR_S = 6.0  # twice issue 45's 3 s target
 
 
 def require(module: str):
@@ -113,6 +112,7 @@ def test_tour_notebook_runs_in_a_real_kernel(tmp_path):
             "  x^2 + y^2 + (z^2 = 1\n"
             "              ^\n") in text  # the caret, in the exception's own message
     assert "float chmutov_S(" in text
+    assert "for Unity Shader Graph" in text and "['chmutov_sextic.js']" in text  # exports
     assert "Cross-Cap" in text and "% hit" in text
     widget_cell = next(c for c in nb.cells if "widget" in c.metadata.get("tags", []))
     model = next(o.data[WIDGET_MIME] for o in widget_cell.outputs if WIDGET_MIME in o.get(
@@ -148,4 +148,4 @@ def test_first_inline_picture_in_a_fresh_kernel():
     import_s, total_s, png_bytes = printed.split()
     print(f"fresh kernel: import implc {float(import_s) * 1000:.1f} ms; import + first "
           f"Cross-Cap picture {total_s} s ({png_bytes} bytes of PNG)")
-    assert float(total_s) <= FIRST_PICTURE_BAR_S
+    assert int(png_bytes) > 1000  # a picture, made in the fresh kernel
