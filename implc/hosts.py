@@ -73,6 +73,17 @@ HOSTS: dict[str, Host] = {host.name: host for host in (
                                      "no integer bit operations; its stackless subdivision "
                                      "needs them"},
     ),
+    Host(
+        name="wesl",
+        about="WESL (Bevy, the npm wesl linker): a package, the surface a module that a "
+              "full-screen pass imports",
+        shaders=(HostShader("wgsl", "wgsl"),),
+        files={"{stem}.wesl": "hosts/wesl/surface.wesl.j2",
+               "{stem}_draw.wesl": "hosts/wesl/draw.wesl.j2",
+               "wesl.toml": "hosts/wesl/wesl.toml.j2"},
+        precision_reason="WGSL has no double",
+        prefix="",  # a module is its own namespace: package::{stem}::intersect
+    ),
 )}
 
 
