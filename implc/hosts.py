@@ -61,6 +61,17 @@ HOSTS: dict[str, Host] = {host.name: host for host in (
         stem_case="pascal",
     ),
     Host(
+        name="godot",
+        about="Godot 4: a spatial .gdshader for a proxy sphere, the ray tracer in a "
+              ".gdshaderinc, the parameters as uniforms with hint_range",
+        # Godot's shading language is GLSL ES 3.00's core; the .gdshader declares the
+        # parameters itself (hint_range), the include only reads them
+        shaders=(HostShader("glsl", "glsl", "es300", declare_params=False),),
+        files={"{stem}.gdshader": "hosts/godot/spatial.gdshader.j2",
+               "{stem}.gdshaderinc": "hosts/godot/include.gdshaderinc.j2"},
+        precision_reason="Godot's shading language has no double",
+    ),
+    Host(
         name="isf",
         about="ISF hosts (VDMX, Resolume, ossia score): a generator .fs, the parameters "
               "as its INPUTS",
