@@ -11,8 +11,9 @@ OUT := out
 # test extras).
 APT_PACKAGES := glslang-tools spirv-cross libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
   pocl-opencl-icd chromium
-# three.js, an ISF renderer and the WESL linker for the browser tests, pinned in
-# tests/browser/package-lock.json (npm ci; no install scripts: none of them needs one).
+# three.js, an ISF renderer, the WESL linker and Godot 4's web build for the browser tests,
+# pinned in tests/browser/package-lock.json (npm ci; no install scripts: none of them
+# needs one, and the Godot package's would copy its build into the project's root).
 NPM_DIR := tests/browser
 NPM_STAMP := $(NPM_DIR)/node_modules/.implc-installed
 VIEW_SURFACE := torus

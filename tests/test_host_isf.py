@@ -19,6 +19,7 @@ import pytest
 from browser_support import background_mask, file_url, open_page, screenshot, ssim, to_8bit
 from conftest import _require, require_tool
 from test_browser import MASK_AGREEMENT, NPM_DIR, SSIM_SAME
+from test_cli import implc
 
 import implc as api
 from implc.emit import render_template
@@ -115,6 +116,9 @@ def test_the_isf_file_is_glsl_es_100_where_the_library_is_not_es300_only(tmp_pat
         assert proc.returncode == 0, f"{method}: {proc.stdout}"
 
 
-def test_isf_refuses_the_interval_method_with_the_reason():
+def test_isf_refuses_the_interval_method_with_the_reason(tmp_path):
     with pytest.raises(OptionError, match="isf host cannot take it.*bit operations"):
         api.Surface.example("torus").export("isf", "interval")
+    proc = implc("export", "torus", "--host", "isf", "-m", "interval", "-o", str(tmp_path))
+    assert proc.returncode == 2 and "bit operations" in proc.stderr
+    assert list(tmp_path.iterdir()) == []
