@@ -11,7 +11,9 @@ OUT := out
 # test extras).
 APT_PACKAGES := glslang-tools spirv-cross libegl1 libegl-mesa0 libgl1-mesa-dri mesa-vulkan-drivers libvulkan1 \
   pocl-opencl-icd chromium
-# three.js for the browser tests, pinned in tests/browser/package-lock.json (npm ci).
+# three.js, an ISF renderer, the WESL linker and Godot 4's web build for the browser tests,
+# pinned in tests/browser/package-lock.json (npm ci; no install scripts: none of them
+# needs one, and the Godot package's would copy its build into the project's root).
 NPM_DIR := tests/browser
 NPM_STAMP := $(NPM_DIR)/node_modules/.implc-installed
 VIEW_SURFACE := torus
@@ -46,7 +48,7 @@ $(NPM_STAMP): $(NPM_DIR)/package.json $(NPM_DIR)/package-lock.json
 	@command -v npm >/dev/null || { echo "installing Debian packages: nodejs npm"; \
 	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq nodejs npm >/dev/null; }
-	cd $(NPM_DIR) && npm ci --no-audit --no-fund --loglevel=error
+	cd $(NPM_DIR) && npm ci --no-audit --no-fund --ignore-scripts --loglevel=error
 	touch $@
 
 demo: setup

@@ -166,6 +166,7 @@ def compile_shader(
     evaluation: str | None = None,
     params: str = "constant",
     static_params: bool = False,
+    declare_params: bool = True,
 ) -> CompiledShader:
     """The shader for `surface` (its text deterministic, byte for byte) and what was
     decided on the way.
@@ -174,7 +175,9 @@ def compile_shader(
     keeps them as uniforms the host sets at run time (`param_uniforms`), or, with
     `static_params` (a host's node function that takes them as inputs: implc/hosts.py),
     as globals that function sets before its calls (HLSL's `static`, GLSL's plain
-    globals)."""
+    globals). `declare_params` False leaves the uniforms' declarations to the host (an
+    ISF input, a Godot uniform with its hint_range: implc/hosts.py); the functions read
+    them by the same names."""
     check_shader_options(target, flavor, precision, prefix, emit_form, params)
     tgt = get_target(target)
     meth = get_method(method)
@@ -224,6 +227,7 @@ def compile_shader(
         "flavor_name": flavor,
         "precision": precision,
         "static_params": static_params,
+        "declare_params": declare_params,
         "shading": print_shading(surface.view, shade_printer),
         "view": _print_view(surface.view, shade_printer),
     }

@@ -16,6 +16,7 @@ from .emit import CompiledShader, compile_shader, render_template
 from .errors import OptionError
 from .hosts import Host
 from .methods import Constants, get_method
+from .scene import SHADING
 from .surface import Surface
 from .version import __version__
 
@@ -54,6 +55,9 @@ def export_files(surface: Surface, host: Host, method: str,
     if precision not in host.precisions:
         raise OptionError(f"--precision {precision}: the {host.name} host cannot take it "
                           f"({host.precision_reason})")
+    if get_method(method).name in host.methods_refused:
+        raise OptionError(f"-m {method}: the {host.name} host cannot take it "
+                          f"({host.methods_refused[get_method(method).name]})")
     name = stem(surface.name, host.stem_case)
     prefix = host.prefix.format(stem=stem(surface.name, "snake")) if prefix is None else prefix
     meth = get_method(method)
@@ -61,18 +65,25 @@ def export_files(surface: Surface, host: Host, method: str,
     shaders: dict[str, CompiledShader] = {
         s.key: compile_shader(surface, s.target, method, constants, s.flavor, "library",
                               prefix, precision, params="uniform",
-                              static_params=s.static_params)
+                              static_params=s.static_params,
+                              declare_params=s.declare_params)
         for s in host.shaders}
     first = next(iter(shaders.values()))
     controls = [Control(u.name, u.uniform, u.value,
-                        u.value - max(abs(u.value), CONTROL_MIN_HALF_WIDTH),
-                        u.value + max(abs(u.value), CONTROL_MIN_HALF_WIDTH))
+                        _round(u.value - max(abs(u.value), CONTROL_MIN_HALF_WIDTH)),
+                        _round(u.value + max(abs(u.value), CONTROL_MIN_HALF_WIDTH)))
                 for u in first.uniforms]
     context = {
         "host": host, "stem": name, "prefix": prefix, "method": meth.name,
         "surface": {"name": surface.name, "equation": surface.symbolic_equation},
         "shaders": shaders, "controls": controls, "view": surface.view,
+        "background": SHADING.background,
         "version": __version__, "command": command, "extras": host.extras,
     }
     return {pattern.format(stem=name): render_template(template, **context)
             for pattern, template in host.files.items()}
+
+
+def _round(x: float) -> float:
+    """A control's end to 6 significant digits (0.35 - 0.5 is -0.15000000000000002)."""
+    return float(f"{x:.6g}")

@@ -26,6 +26,9 @@ class HostShader:
     # the parameters as globals the host's function sets (its node's inputs) rather than
     # uniforms the host binds (emit.compile_shader's static_params)
     static_params: bool = False
+    # False: the host's file declares the parameters' uniforms itself (an ISF input, a
+    # Godot uniform with a hint_range), so the library only reads them (GLSL)
+    declare_params: bool = True
 
 
 @dataclass(frozen=True)
@@ -39,6 +42,8 @@ class Host:
     precisions: tuple[str, ...] = ("float",)  # what its shading language can solve in
     # why a precision the host lacks is refused (the message's reason)
     precision_reason: str = "the host's shading language has no double"
+    # method -> why the host's shading language cannot run it (the refusal's reason)
+    methods_refused: Mapping[str, str] = field(default_factory=dict)
     # a prefix for the library's global names when the caller gives none ({stem}_)
     prefix: str = "{stem}_"
     # how a name is spelled for the host's files: "snake" (my_surface) or "pascal"
@@ -96,6 +101,41 @@ HOSTS: dict[str, Host] = {host.name: host for host in (
             "RayOrigin", "RayDirection", "TNear", "TFar", "Hit", "T", "Normal", "Parameters",
             "t", "hit", "g", "MaterialFloat", "MaterialFloat2", "MaterialFloat3",
             "MaterialFloat4"}},
+    ),
+    Host(
+        name="godot",
+        about="Godot 4: a spatial .gdshader for a proxy sphere, the ray tracer in a "
+              ".gdshaderinc, the parameters as uniforms with hint_range",
+        # Godot's shading language is GLSL ES 3.00's core; the .gdshader declares the
+        # parameters itself (hint_range), the include only reads them
+        shaders=(HostShader("glsl", "glsl", "es300", declare_params=False),),
+        files={"{stem}.gdshader": "hosts/godot/spatial.gdshader.j2",
+               "{stem}.gdshaderinc": "hosts/godot/include.gdshaderinc.j2"},
+        precision_reason="Godot's shading language has no double",
+    ),
+    Host(
+        name="isf",
+        about="ISF hosts (VDMX, Resolume, ossia score): a generator .fs, the parameters "
+              "as its INPUTS",
+        # GLSL ES 1.00 / 1.20, what ISF hosts compile: the es300 library is in that subset
+        # but for the interval method's bit operations
+        shaders=(HostShader("glsl", "glsl", "es300", declare_params=False),),
+        files={"{stem}.fs": "hosts/isf/generator.fs.j2"},
+        precision_reason="ISF shaders are GLSL ES 1.00 / GLSL 1.20, which have no double",
+        methods_refused={"interval": "ISF shaders are GLSL ES 1.00 / GLSL 1.20, which have "
+                                     "no integer bit operations; its stackless subdivision "
+                                     "needs them"},
+    ),
+    Host(
+        name="wesl",
+        about="WESL (Bevy, the npm wesl linker): a package, the surface a module that a "
+              "full-screen pass imports",
+        shaders=(HostShader("wgsl", "wgsl"),),
+        files={"{stem}.wesl": "hosts/wesl/surface.wesl.j2",
+               "{stem}_draw.wesl": "hosts/wesl/draw.wesl.j2",
+               "wesl.toml": "hosts/wesl/wesl.toml.j2"},
+        precision_reason="WGSL has no double",
+        prefix="",  # a module is its own namespace: package::{stem}::intersect
     ),
 )}
 
