@@ -118,12 +118,16 @@ def evaluate_on_grid(expr: sympy.Expr, axes: Sequence[np.ndarray]) -> np.ndarray
     corpus's degree-18 torus knot with its 207 terms) is contracted one axis at a time
     from its coefficient tensor: about n^3 (d + 1) operations for d + 1 coefficients an
     axis, where the walker forms every monomial at every one of the n^3 points (1 s
-    against 0.02 s for that knot on framing's 65^3 grid). Anything else: the walker."""
+    against 0.02 s for that knot on framing's 65^3 grid). Anything else: the walker, on
+    the axes broadcast rather than on a mesh."""
     monomials = _monomials(expr)
-    if monomials is None:
-        grid = np.meshgrid(*axes, indexing="ij")
-        values = evaluate(expr, dict(zip(POINT, grid, strict=True)))
-        return np.broadcast_to(values, grid[0].shape)
+    if monomials is None:  # each axis along its own dimension: a part of S in x alone is
+        # evaluated on the x axis, one in x and y on a plane, by numpy's broadcasting
+        shape = tuple(len(a) for a in axes)
+        env = {v: np.asarray(a, dtype=np.float64).reshape([-1 if k == i else 1
+                                                             for k in range(3)])
+               for i, (v, a) in enumerate(zip(POINT, axes, strict=True))}
+        return np.broadcast_to(evaluate(expr, env), shape)
     degrees = [max(m[axis] for m in monomials) + 1 for axis in range(3)]
     tensor = np.zeros(degrees)
     for exponents, coefficient in monomials.items():
