@@ -140,6 +140,9 @@ def gpu_stats(shaders: Sequence[CompiledShader],
     """Each family -> the statistics of each shader's fragment stage, in order. ToolError
     where RADV or glslang is missing or a family is unknown to RADV."""
     names = [check_family(f) for f in families]
+    for shader in shaders:  # an option's mistake before a tool's absence
+        if problem := spirv_problem(shader):
+            raise OptionError(f"GPU statistics: {problem}")
     if problem := radv_problem():
         raise ToolError(f"GPU statistics need Mesa's RADV: {problem}")
     request = json.dumps({"vertex": vertex_spirv().hex(),
