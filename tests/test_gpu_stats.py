@@ -87,7 +87,7 @@ def test_no_method_spills(radv) -> None:
 
 def test_show_prints_the_statistics(radv) -> None:
     """`implc show --gpu-stats` prints one line per family and program; an unknown family
-    is a usage error naming it."""
+    is a usage error naming it, and so is a GPU option without --gpu-stats."""
     cmd = [sys.executable, "-m", "implc", "show", "torus", "--gpu-stats"]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     out = subprocess.run(cmd + ["--gpu-family", "navi21"], capture_output=True, text=True,
@@ -98,6 +98,9 @@ def test_show_prints_the_statistics(radv) -> None:
     bad = subprocess.run(cmd + ["--gpu-family", "navi99"], capture_output=True, text=True,
                          env=env, timeout=300)
     assert bad.returncode == 2 and "navi99" in bad.stderr
+    alone = subprocess.run(cmd[:-1] + ["--precision", "double"], capture_output=True,
+                           text=True, env=env, timeout=300)
+    assert alone.returncode == 2 and "--gpu-stats" in alone.stderr
 
 
 def test_a_target_without_spirv_is_refused() -> None:
