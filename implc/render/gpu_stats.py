@@ -113,10 +113,14 @@ def _glslang(text: str, stage: str, hlsl: bool) -> bytes:
         return Path(spirv).read_bytes()
 
 
-def fragment_spirv(shader: CompiledShader) -> bytes:
-    """The program's fragment stage as SPIR-V (OptionError where it has no path there)."""
+def _check_spirv(shader: CompiledShader) -> None:
     if problem := spirv_problem(shader):
         raise OptionError(f"GPU statistics: {problem}")
+
+
+def fragment_spirv(shader: CompiledShader) -> bytes:
+    """The program's fragment stage as SPIR-V (OptionError where it has no path there)."""
+    _check_spirv(shader)
     return _glslang(shader.text, "frag", hlsl=shader.target == "hlsl")
 
 
@@ -141,8 +145,7 @@ def gpu_stats(shaders: Sequence[CompiledShader],
     where RADV or glslang is missing or a family is unknown to RADV."""
     names = [check_family(f) for f in families]
     for shader in shaders:  # an option's mistake before a tool's absence
-        if problem := spirv_problem(shader):
-            raise OptionError(f"GPU statistics: {problem}")
+        _check_spirv(shader)
     if problem := radv_problem():
         raise ToolError(f"GPU statistics need Mesa's RADV: {problem}")
     request = json.dumps({"vertex": vertex_spirv().hex(),
@@ -175,6 +178,10 @@ def _ask(family: str, request: str) -> list[GpuStats]:
         raise ToolError(f"RADV ({family}): {answer['error']}{hint}")
     if "RADV" not in answer["device"]:
         raise ToolError(f"the device for {family} is {answer['device']!r}, not RADV's")
+    missing = [name for name in NAMES if answer["stats"] and name not in answer["stats"][0]]
+    if missing:  # another Mesa may name them otherwise: say so, never guess
+        raise ToolError(f"RADV ({answer['device']}) reports no {', '.join(missing)} (it "
+                        f"reports {', '.join(answer['stats'][0])})")
     return [GpuStats(family=family, device=answer["device"],
                      **{field: int(stats[name]) for name, field in NAMES.items()})
             for stats in answer["stats"]]
