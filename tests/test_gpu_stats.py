@@ -5,7 +5,7 @@ The guard: no method spills registers on those families in float, over the degre
 sweep's Chmutov surfaces and bundled ones, in HLSL and in GLSL 450 (a spill is scratch
 memory in the inner loop, "devastating" per Peters et al.), nor in double (GLSL 450)
 below degree 10. `make test` samples degrees
-2, 4, 8, 12, 16, 20 (~40 s here); the whole sweep:
+2, 4, 8, 12, 16, 20 (the guard ~12 s here); the whole sweep (~35 s):
 
     IMPLC_GPU_DEGREES=2-20 pytest tests/test_gpu_stats.py
 
