@@ -106,6 +106,20 @@ forms: setup
 	  sphere kummer cayley clebsch ding-dong whitney-umbrella barth-sextic heart
 	$(PY) scripts/eval_forms.py sweep --size 512 --frames 5 --degrees 2-20 --plot docs/cost-growth.png
 
+# What AMD's compiler makes of the degree sweep (issue 49): RADV's ACO statistics on null
+# devices (no GPU needed) of Chmutov T_2..T_20's programs, every method, float and double,
+# written into docs/RESULTS.md section 10 (scripts/gpu_stats_table.py). About 2 minutes.
+.PHONY: gpu-stats-table gpu-bench
+gpu-stats-table: setup
+	$(PY) scripts/gpu_stats_table.py --write docs/RESULTS.md
+
+# For a machine with a real GPU: the frame table of every method over Chmutov T_2..T_20
+# and the hand-written baselines at 1024^2 and 2048^2, the device named
+# (scripts/gpu_bench.py; GPU_BACKEND=wgpu for Vulkan/Metal/D3D12 through wgpu).
+GPU_BACKEND := gl
+gpu-bench: setup
+	$(PY) scripts/gpu_bench.py --backend $(GPU_BACKEND) --sizes 1024,2048 --degrees 2-20 --frames 10
+
 # Fuzzing (tests/test_fuzz.py) at FUZZ_SCALE times the short pass that `make test` runs
 # (FUZZ_PATH_SCALE for the slower whole-path tests), a fresh seed each run: 100,000+
 # parser cases (grammar + mutation) and ~4,600 whole-path cases (parse, derive, CSE,

@@ -96,3 +96,7 @@ T_TOL = 1e-3
 # The unit roundoff of each precision a shader prints in (the solver's rounding bounds and
 # touch tolerance, the float32 conditioning `implc show` measures)
 UNIT_ROUNDOFF = {"float": 2.0**-24, "double": 2.0**-53}
+
+# The AMD families whose compiler statistics `implc show --gpu-stats` and
+# Shader.gpu_stats report by default (RADV's names: RDNA2 and RDNA3; render/gpu_stats.py)
+GPU_FAMILIES = ("navi21", "gfx1100")

@@ -10,6 +10,7 @@ warnings and text.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -17,12 +18,14 @@ from typing import TYPE_CHECKING, Any
 from ..emit import CompiledShader, render_template
 from ..errors import ValidationError
 from ..fileio import write_atomic
+from ..options import GPU_FAMILIES
 from ..scene import View
 from ..targets import get_target
 
 if TYPE_CHECKING:
     import numpy as np
 
+    from ..render.gpu_stats import GpuStats
     from ..render.result import RenderResult
     from ..surface import Surface as SurfaceRecord
     from ..validate import Verdict
@@ -62,6 +65,15 @@ class Shader(CompiledShader):
         if not verdict.ok:
             raise ValidationError(verdict.render(name))
         return verdict
+
+    def gpu_stats(self, families: Sequence[str] = GPU_FAMILIES) -> list[GpuStats]:
+        """What AMD's compiler (ACO, in Mesa's RADV, on a null device: no GPU needed) makes
+        of this program on each family: VGPRs, SGPRs, spills, scratch, waves per SIMD,
+        instructions. For an HLSL or a desktop GLSL (330, 450) program; ToolError where
+        RADV is absent."""
+        from ..render.gpu_stats import gpu_stats
+
+        return [rows[0] for rows in gpu_stats([self], families).values()]
 
     def save(self, path: str | Path) -> Path:
         """Write the text to `path` (atomically: no partial file) and return the path."""

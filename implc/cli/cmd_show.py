@@ -1,12 +1,16 @@
-"""`implc show`: what implc understood and what it will compute."""
+"""`implc show`: what implc understood and what it will compute (and, with --gpu-stats,
+what AMD's compiler makes of the program: registers, spills, occupancy)."""
 
 from __future__ import annotations
 
 import argparse
 
-from ..errors import EXIT_OK
-from ..options import METHOD_NAMES
+from ..errors import EXIT_OK, OptionError
+from ..options import GPU_FAMILIES, METHOD_NAMES
 from . import args as common
+
+# the programs that reach SPIR-V, per precision: (target, flavour)
+SPIRV_PROGRAMS = {"float": (("hlsl", None), ("glsl", "450")), "double": (("glsl", "450"),)}
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -16,9 +20,39 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="method whose shader functions to count (default: exact for "
                         "polynomials, else interval where every function has an interval "
                         "rule, else hessian)")
+    g = p.add_argument_group("GPU statistics (Mesa's RADV on a null device: no GPU needed)")
+    g.add_argument("--gpu-stats", action="store_true", dest="gpu_stats",
+                   help="also print what AMD's compiler (ACO) makes of the method's program "
+                        "for each family: VGPRs, SGPRs, spills, scratch, waves per SIMD, "
+                        "instructions (HLSL and GLSL 450 programs through SPIR-V)")
+    g.add_argument("--gpu-family", default=None, dest="gpu_family",
+                   metavar="F1,F2",
+                   help=f"RADV family names (default {','.join(GPU_FAMILIES)}: RDNA2, RDNA3; "
+                        "e.g. polaris10 for GCN)")
+    g.add_argument("--precision", choices=sorted(SPIRV_PROGRAMS), default=None,
+                   help="precision of the programs measured (double: GLSL 450 only, HLSL "
+                        "has float only; default float)")
 
 
 def run(args: argparse.Namespace) -> int:
+    if not args.gpu_stats and (args.gpu_family or args.precision):
+        raise OptionError("--gpu-family and --precision apply with --gpu-stats only")
+    families = [f.strip() for f in (args.gpu_family or ",".join(GPU_FAMILIES)).split(",")]
+    precision = args.precision or "float"
+    if args.gpu_stats:
+        from ..render.gpu_stats import check_family
+
+        families = [check_family(f) for f in families if f]
+        if not families:
+            raise OptionError("--gpu-family: name at least one family, e.g. navi21")
     surface = common.surface(args)
     print(surface.describe(args.method))
+    if args.gpu_stats:
+        for target, flavor in SPIRV_PROGRAMS[precision]:
+            shader = surface.compile(target, args.method, flavor=flavor, precision=precision)
+            name = f"{target}{' ' + flavor if flavor else ''}"
+            print(f"\nGPU statistics of the {shader.method} program, {name}, "
+                  f"{precision} (RADV/ACO, fragment stage):")
+            for stats in shader.gpu_stats(families):
+                print(f"  {stats.line()}")
     return EXIT_OK
