@@ -42,7 +42,7 @@ FSIZE = 64  # bytes: under RLIMIT_FSIZE every output (and temp file) is larger
 SLOW = "sin(" * 34 + "x*y*z" + ")" * 34  # ~2.6 s of CPU in derive + CSE
 
 COMMANDS = ("list", "show", "compile", "validate", "render", "compare", "bench", "corpus",
-            "view", "gallery")
+            "view", "gallery", "export")
 FAULTS = ("missing input", "unreadable input", "directory input", "directory output",
           "unwritable output", "full disk", "SIGINT", "SIGTERM")
 STDOUT_ONLY = {"list", "show", "validate", "compare"}
@@ -99,12 +99,13 @@ def good_input(cmd: str, place: Path) -> str:
                 "view": inputs / "surface.toml",
                 "render": inputs / "surface.toml", "bench": inputs / "surface.toml",
                 "validate": inputs / "shader.frag", "compare": inputs / "render.exr",
-                "corpus": inputs / "corpus.tsv", "gallery": inputs / "surface.toml"}.get(cmd, ""))
+                "corpus": inputs / "corpus.tsv", "gallery": inputs / "surface.toml",
+                "export": inputs / "surface.toml"}.get(cmd, ""))
 
 
 def output_name(cmd: str) -> str:
     return {"compile": "out.frag", "render": "out.png", "bench": "bench-out", "view": "out.html",
-            "corpus": "report.md", "gallery": "gallery-out"}.get(cmd, "")
+            "corpus": "report.md", "gallery": "gallery-out", "export": "export-out"}.get(cmd, "")
 
 
 def argv(cmd: str, inp: str, out: str, place: Path) -> list[str]:
@@ -121,6 +122,7 @@ def argv(cmd: str, inp: str, out: str, place: Path) -> list[str]:
                   "--configs", "paper", "-o", out],
         "corpus": ["corpus", inp, "--rows", "1-3", "-j", "1", "--no-validate", "-o", out],
         "gallery": ["gallery", inp, "--size", "16", "-o", out],
+        "export": ["export", inp, "--host", "unity", "-o", out],
     }[cmd]
 
 
@@ -213,7 +215,7 @@ def test_fault(cmd, fault, place):
                         folder.with_suffix(".json"))
         inp, needle = str(folder), "directory"
     elif fault == "directory output":
-        if cmd in ("bench", "gallery"):  # a directory: a file in its place is the fault
+        if cmd in ("bench", "gallery", "export"):  # a directory: a file in its place is the fault
             Path(out).write_text("not a directory\n")
             needle = "is a file, not a directory"
         else:
@@ -251,7 +253,7 @@ def test_fault(cmd, fault, place):
     if fault == "directory output":
         expected = {output_name(cmd)}
     assert set(leftovers(out_dir)) == expected, leftovers(out_dir)
-    if fault == "directory output" and cmd not in ("bench", "gallery"):
+    if fault == "directory output" and cmd not in ("bench", "gallery", "export"):
         assert leftovers(Path(out)) == []
 
 
@@ -313,6 +315,8 @@ def signal_case(cmd: str, fault: str, place: Path) -> None:
     args = argv(cmd, inp, out, place)
     if cmd in ("compile", "view"):
         args = [cmd, "-e", SLOW, "-o", out]
+    elif cmd == "export":
+        args = ["export", "-e", SLOW, "--host", "unity", "-o", out]
     elif cmd == "render":
         args = ["render", inp, "-b", "reference", "--size", "1024", "-o", out]
     elif cmd == "bench":
@@ -336,6 +340,7 @@ def signal_case(cmd: str, fault: str, place: Path) -> None:
     ready = {
         "compile": lambda: cpu_seconds(proc.pid) > 1.0,
         "view": lambda: cpu_seconds(proc.pid) > 1.0,
+        "export": lambda: cpu_seconds(proc.pid) > 1.0,
         "render": lambda: cpu_seconds(proc.pid) > 1.0,
         "bench": lambda: any(p.name.startswith(".bench-out.partial-")
                              for p in out_dir.iterdir()) and cpu_seconds(proc.pid) > 1.0,
@@ -380,4 +385,4 @@ def test_matrix_is_complete():
     sub = next(a for a in parser._actions if a.dest == "command")
     assert set(sub.choices) == set(COMMANDS)
     applicable = [case for case in CASES if case not in NOT_APPLICABLE]
-    assert len(applicable) == len(CASES) - len(NOT_APPLICABLE) == 70
+    assert len(applicable) == len(CASES) - len(NOT_APPLICABLE) == 78

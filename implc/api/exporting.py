@@ -29,17 +29,15 @@ class HostFiles:
         return next(iter(self.files.values()))
 
     def save(self, directory: str | Path = ".") -> list[Path]:
-        """Write every file into `directory` (made if missing), each atomically; the
-        paths written."""
-        from ..fileio import write_atomic
+        """Write every file into `directory` (made if missing): all of them or, on an
+        error or an interruption, none (staged beside it, then moved in); the paths."""
+        from ..fileio import check_output_dir, staged_directory
 
-        folder = Path(directory)
-        folder.mkdir(parents=True, exist_ok=True)
-        written = []
-        for name, text in self.files.items():
-            write_atomic(folder / name, text)
-            written.append(folder / name)
-        return written
+        folder = check_output_dir(directory, what=f"{self.host} host's directory")
+        with staged_directory(folder) as stage:
+            for name, text in self.files.items():
+                (stage / name).write_text(text, encoding="utf-8")
+        return [folder / name for name in self.files]
 
     def __str__(self) -> str:
         return self.main

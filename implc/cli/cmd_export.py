@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import EXIT_OK
+from ..fileio import check_output_dir
 from ..hosts import HOSTS
 from . import args as common
 
@@ -40,9 +41,7 @@ def run(args: argparse.Namespace) -> int:
         get_host(args.host)  # an unknown host is a bad command line, before any work
     except ValueError as err:
         raise common.UsageError(f"--host: {err}", "implc export") from None
-    if args.output.exists() and not args.output.is_dir():
-        raise common.UsageError(f"-o {args.output}: not a directory (export writes a host's "
-                                "files into a directory)", "implc export")
+    check_output_dir(args.output, what="output directory")  # before any work
     surface = common.surface(args)
     method = args.method or surface.default_method
     common.warn_ignored(args, method)
