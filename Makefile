@@ -23,7 +23,7 @@ VIEW_SURFACE := torus
 SLANGTORCH := 1.3.22
 
 .PHONY: setup demo view test golden lint bench bench-baseline forms clean system-packages fuzz corpus \
-  compile-times startup
+  compile-times startup docs
 
 setup: system-packages $(STAMP) $(NPM_STAMP)
 
@@ -65,6 +65,12 @@ view: setup
 
 test: lint
 	$(PY) -m pytest
+
+# The documentation site (mkdocs.yml, pages under docs/) into site/, strictly: a broken
+# link or anchor, a page missing from the nav or a missing included file fails the build.
+# Offline: the theme comes from the `docs` extra, no plugin fetches, no web font.
+docs: setup
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --quiet -d site
 
 # Rewrite every golden shader (every target of implc/targets.py) from the current output;
 # review the diff.
@@ -172,4 +178,4 @@ three-picture: setup
 	IMPLC_SCREENSHOTS=docs $(PY) -m pytest tests/test_host_three.py -q -k "torus and webgpu and not webgl2"
 
 clean:
-	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules
+	rm -rf $(OUT) site build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules
