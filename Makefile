@@ -72,6 +72,12 @@ test: lint
 docs: setup
 	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --quiet -d site
 
+# The command line's reference page, written from the parser (tests/test_docs.py fails
+# when the committed page is stale).
+.PHONY: cli-reference
+cli-reference: setup
+	$(PY) scripts/cli_reference.py > docs/reference/cli.md
+
 # Rewrite every golden shader (every target of implc/targets.py) from the current output;
 # review the diff.
 # Each new text is validated by its real compiler before it is written (an invalid one is

@@ -35,3 +35,15 @@ def test_the_site_builds_strictly_and_loads_nothing_from_the_network(tmp_path):
     remote = re.compile(r'<(?:script|link|img)\b[^>]*\b(?:src|href)="(?:https?:)?//', re.I)
     fetched = [str(p.relative_to(site)) for p in pages if remote.search(p.read_text("utf-8"))]
     assert not fetched, f"pages that load from the network: {fetched}"
+
+
+def test_the_command_line_reference_is_the_parser_s():
+    """docs/reference/cli.md is what scripts/cli_reference.py writes from build_parser():
+    an option added, renamed or re-described without `make cli-reference` fails here."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    try:
+        from cli_reference import page
+    finally:
+        sys.path.remove(str(ROOT / "scripts"))
+    committed = (ROOT / "docs" / "reference" / "cli.md").read_text(encoding="utf-8")
+    assert committed == page(), "docs/reference/cli.md is stale: run `make cli-reference`"
