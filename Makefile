@@ -167,13 +167,13 @@ compile-times: setup
 startup: setup
 	$(PY) scripts/startup.py
 
-# The README's gallery pictures (docs/gallery-examples.png, docs/gallery-corpus.png):
+# The docs' gallery pictures (docs/gallery-examples.png, docs/gallery-corpus.png):
 # `implc gallery` of the bundled examples and of 24 corpus rows at 96 pixels. About 20 s.
 .PHONY: gallery-pictures
 gallery-pictures: setup
 	$(PY) scripts/gallery_pictures.py
 
-# The README's notebook figure (docs/notebook-widget.png): tests/test_jupyterlab.py's
+# The docs' notebook figure (docs/notebook-widget.png): tests/test_jupyterlab.py's
 # screenshot of the tour's widget cell in JupyterLab. About 30 s.
 .PHONY: notebook-picture
 notebook-picture: setup

@@ -132,7 +132,7 @@ def _surface(props: Properties, path: Path, overrides: Mapping[str, sympy.Expr],
         notes += (f"implc: note: {props.name}: jsurf 0.4.1 draws this PERSPECTIVE_CAMERA "
                   "beside what it looks at (its window spans 1 to 3 times tan(fov/2) up "
                   "and right of the axis); implc draws the camera's centred view, as "
-                  "jsurf's code means it (README \"SURFER files\")",)
+                  "jsurf's code means it (the docs' \"SURFER files\")",)
     return Surface(path.stem, expr, values, view, str(path), symbolic, notes, limits)
 
 
