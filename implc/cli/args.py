@@ -330,7 +330,7 @@ def _spoken(flags: list[str]) -> str:
 def warn_ignored(args: argparse.Namespace, method: str, reference: bool = False) -> None:
     """A method constant the method does not read (--step with exact), or any method
     option with the CPU reference, is said on stderr and ignored (exit 0), never dropped
-    silently (README "Command line"). What a method reads comes from its data
+    silently (docs/guide/command-line.md "Command line"). What a method reads comes from its data
     (`Method.reads`), not from a list here."""
     given = constants_given(args)
     if reference:

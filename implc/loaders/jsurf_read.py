@@ -2,7 +2,8 @@
 and the front/back colours (the file's syntax: `jsurf_properties`; its equation's grammar:
 `jsurf_grammar`; writing one: `jsurf_write`).
 
-The view (README "SURFER files"): jsurf maps camera space to its clipping space by
+The view (docs/guide/surfer-and-gallery.md "SURFER files"): jsurf maps camera space to its clipping
+space by
 `transform_matrix * rotation_matrix * camera_transform^-1` and clipping space to the
 surface's by `surface_transform_matrix * 10^scale_factor`; the clip sphere is the unit
 sphere of clipping space. A perspective camera (`PERSPECTIVE_CAMERA`) is implc's camera
