@@ -112,7 +112,7 @@ bench-baseline: setup
 	done
 
 # Point versus ray-poly evaluation (accuracy, speed), and the degree sweep (exact against
-# taylor and hessian, degree 2-20, docs/RESULTS.md section 7) with its plot: ~50 minutes.
+# taylor and hessian, degree 2-20, docs/RESULTS.md, "The degree sweep") with its plot: ~50 minutes.
 forms: setup
 	$(PY) scripts/eval_forms.py accuracy --size 512 cross-cap miter steiner roman torus tooth \
 	  sphere kummer cayley clebsch ding-dong whitney-umbrella barth-sextic heart
@@ -120,7 +120,7 @@ forms: setup
 
 # What AMD's compiler makes of the degree sweep (issue 49): RADV's ACO statistics on null
 # devices (no GPU needed) of Chmutov T_2..T_20's programs, every method, float and double,
-# written into docs/RESULTS.md section 10 (scripts/gpu_stats_table.py). About 2 minutes.
+# written into docs/RESULTS.md, "What a GPU's compiler says" (scripts/gpu_stats_table.py). About 2 minutes.
 .PHONY: gpu-stats-table gpu-bench
 gpu-stats-table: setup
 	$(PY) scripts/gpu_stats_table.py --write docs/RESULTS.md
@@ -157,7 +157,7 @@ corpus-interval: setup
 
 # Compile time of every corpus row as a user meets it (`implc compile -e ROW`, default
 # method, GLSL, a fresh process each, two at a time): the distribution and the slowest
-# ten (docs/RESULTS.md section 6). About 2 minutes on 2 cores.
+# ten (docs/RESULTS.md, "Compile time on the corpus"). About 2 minutes on 2 cores.
 compile-times: setup
 	$(PY) scripts/compile_times.py -j 2
 

@@ -42,7 +42,7 @@ from implc.render.run import open_runner  # noqa: E402
 FORMS = ("point", "ray-poly")
 # The sweep compiles each program COPIES times and times them all in the same rounds,
 # keeping the faster copy's median: llvmpipe at times runs one compiled program about
-# 1.4x slower in every frame of a run (docs/RESULTS.md section 8), a compile's lot, not
+# 1.4x slower in every frame of a run (docs/journal/2026-12-05.md), a compile's lot, not
 # the program's. The first copy's compile is the one reported (emit, driver).
 COPIES = 2
 

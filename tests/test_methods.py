@@ -69,7 +69,7 @@ def test_min_and_max_print_as_balanced_trees(target):
 def test_root_test_takes_the_end_sample_last(target):
     """The end sample (F1, F1') is what a march step computes last: F1 is one comparison
     from the root test's answer, F1' one product (optimize.arrange_by_depth), and the
-    values free of F1 are one min (docs/RESULTS.md, section 3)."""
+    values free of F1 are one min (docs/journal/2026-12-01-marcher-and-forms.md)."""
     printer = get_target(target).printer()
     sign, high = printer.known_functions["sign"], printer.known_functions["Max"]
     for method in ("taylor", "hessian"):
