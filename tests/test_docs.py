@@ -78,3 +78,43 @@ def test_the_readme_s_first_commands_run(tmp_path):
         proc = subprocess.run(argv, cwd=tmp_path, capture_output=True, text=True, env=env,
                               timeout=300)
         assert proc.returncode == 0, (command, proc.stderr[-2000:])
+
+
+FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
+GUIDE = [ROOT / "README.md", *sorted((ROOT / "docs" / "guide").glob("*.md")),
+         ROOT / "docs" / "reference" / "input-language.md"]
+
+
+def blocks(language: str) -> list[tuple[str, str]]:
+    """(page, code) of every fenced block in `language` on the README and the guide."""
+    return [(str(page.relative_to(ROOT)), match.group(2))
+            for page in GUIDE for match in FENCE.finditer(page.read_text("utf-8"))
+            if match.group(1) == language]
+
+
+def run(argv: list[str], cwd: Path, where: str) -> None:
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.run(argv, cwd=cwd, capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, (where, argv[-1][:200], proc.stderr[-2000:])
+
+
+def test_the_guide_s_code_blocks_run(tmp_path):
+    """Every Python block of the README and the guide runs as a script, every `implc`
+    line of their shell blocks runs, and every TOML block is a surface file `implc show`
+    reads: an example that drifts from the program fails here. (The JavaScript, HTML and
+    shader blocks are the drop-ins' own tests': tests/test_browser.py, tests/test_wgsl.py.)"""
+    python, shell, toml = blocks("python"), blocks("sh"), blocks("toml")
+    assert len(python) >= 4 and toml, (len(python), len(toml))
+    for n, (page, code) in enumerate(python):
+        work = tmp_path / f"py{n}"
+        work.mkdir()
+        run([sys.executable, "-c", code], work, page)
+    for page, code in shell:  # the README's are test_the_readme_s_first_commands_run's
+        for line in code.splitlines():
+            command = line.split("#", 1)[0].strip()
+            if command.startswith("implc ") and page != "README.md":
+                run([sys.executable, "-m", "implc", *shlex.split(command)[1:]], tmp_path, page)
+    for n, (page, code) in enumerate(toml):
+        surface = tmp_path / f"surface{n}.toml"
+        surface.write_text(code, encoding="utf-8")
+        run([sys.executable, "-m", "implc", "show", str(surface)], tmp_path, page)
