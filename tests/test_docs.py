@@ -118,3 +118,14 @@ def test_the_guide_s_code_blocks_run(tmp_path):
         surface = tmp_path / f"surface{n}.toml"
         surface.write_text(code, encoding="utf-8")
         run([sys.executable, "-m", "implc", "show", str(surface)], tmp_path, page)
+
+
+def test_the_python_reference_names_every_public_name():
+    """docs/reference/python.md renders each name of `implc.__all__` from its docstring
+    (mkdocstrings); a public name added without its entry fails here."""
+    import implc
+
+    page = (ROOT / "docs" / "reference" / "python.md").read_text("utf-8")
+    listed = set(re.findall(r"^::: implc\.api\.(\w+)$", page, re.M))
+    public = set(implc.__all__) - {"__version__"}
+    assert listed == public, f"missing: {public - listed}, not public: {listed - public}"
