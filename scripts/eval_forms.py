@@ -230,7 +230,7 @@ def precision(degrees: list[int], size: int, frames: int,
               plot: str | None = None) -> None:
     """exact and taylor (`--eval auto`), each in float (`gl`) and in double (`gl-double`),
     timed in the same rounds, with their counts against the reference unless `counts` is
-    False (docs/RESULTS.md, "Double precision in GLSL" and "Both methods in double");
+    False (docs/journal/2026-12-04.md, "Double precision in GLSL", "Both methods in double");
     `plot`: exact / taylor in each precision against the degree, drawn there."""
     rows = []
     names = [f"{method} {'double' if backend.endswith('double') else 'float'}"

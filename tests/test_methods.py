@@ -55,7 +55,7 @@ def test_extremum_matches_the_exact_reference(example):
 @pytest.mark.parametrize("target", ["glsl", "wgsl", "opencl"])
 def test_min_and_max_print_as_balanced_trees(target):
     """A root test's min/max over four values is two levels deep, not three: the march
-    loop is bound by its dependency chain (docs/RESULTS.md, generated vs hand-written)."""
+    loop is bound by its dependency chain (docs/journal/2026-12-01-marcher-and-forms.md)."""
     a, b, c, d, e = sympy.symbols("a b c d e", real=True)
     printer = get_target(target).printer()
     name = printer.known_functions["Max"]
