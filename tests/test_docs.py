@@ -129,3 +129,28 @@ def test_the_python_reference_names_every_public_name():
     listed = set(re.findall(r"^::: implc\.api\.(\w+)$", page, re.M))
     public = set(implc.__all__) - {"__version__"}
     assert listed == public, f"missing: {public - listed}, not public: {listed - public}"
+
+
+def test_make_bench_rewrites_its_tables_in_place(tmp_path):
+    """`make bench`'s second step: a real `implc bench` table goes between the results
+    page's bench markers with the command and the commit above it, and not a character of
+    the page outside them moves; a page without the markers is refused."""
+    results = tmp_path / "results"
+    run([sys.executable, "-m", "implc", "bench", "cross-cap", "--size", "32", "--frames", "1",
+         "--configs", "paper", "-o", str(results)], tmp_path, "implc bench")
+    page = tmp_path / "RESULTS.md"
+    before = (ROOT / "docs" / "RESULTS.md").read_text("utf-8")
+    page.write_text(before, encoding="utf-8")
+    script = [sys.executable, str(ROOT / "scripts" / "docs_section.py"), "bench",
+              str(results / "table.md"), "--write"]
+    run([*script, str(page)], tmp_path, "docs_section.py")
+    after = page.read_text("utf-8")
+    span = re.compile(r"<!-- bench:begin -->.*?<!-- bench:end -->", re.S)
+    assert span.sub("", after) == span.sub("", before)
+    table = span.search(after).group(0)
+    assert "Made by `make bench` at commit " in table and "32x32 pixels" in table, table[:400]
+    assert "\n### paper: the paper's constants" in table and "\n# implc bench" not in table
+    bare = tmp_path / "bare.md"
+    bare.write_text("# no markers\n", encoding="utf-8")
+    proc = subprocess.run([*script, str(bare)], capture_output=True, text=True, timeout=60)
+    assert proc.returncode != 0 and "no <!-- bench:begin -->" in proc.stderr, proc.stderr
