@@ -22,7 +22,7 @@ from host_harness import (
 
 from implc.emit import param_uniforms
 
-SHOT = "host-unity.png"  # README's picture (docs/), kept with IMPLC_SCREENSHOTS=DIR
+SHOT = "host-unity.png"  # docs/guide/hosts.md's picture, kept with IMPLC_SCREENSHOTS=DIR
 
 
 @pytest.mark.parametrize("front", FRONT_ENDS)

@@ -23,7 +23,7 @@ from host_harness import (
 
 from implc.emit import param_uniforms
 
-SHOT = "host-unreal.png"  # README's picture (docs/), kept with IMPLC_SCREENSHOTS=DIR
+SHOT = "host-unreal.png"  # docs/guide/hosts.md's picture, kept with IMPLC_SCREENSHOTS=DIR
 
 
 def unreal_harness(tmp_path, example: str) -> tuple[str, object, list]:
