@@ -23,7 +23,7 @@ VIEW_SURFACE := torus
 SLANGTORCH := 1.3.22
 
 .PHONY: setup demo view test golden lint bench bench-baseline forms clean system-packages fuzz corpus \
-  compile-times startup
+  compile-times startup docs
 
 setup: system-packages $(STAMP) $(NPM_STAMP)
 
@@ -66,6 +66,18 @@ view: setup
 test: lint
 	$(PY) -m pytest
 
+# The documentation site (mkdocs.yml, pages under docs/) into site/, strictly: a broken
+# link or anchor, a page missing from the nav or a missing included file fails the build.
+# Offline: the theme comes from the `docs` extra, no plugin fetches, no web font.
+docs: setup
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --quiet -d site
+
+# The command line's reference page, written from the parser (tests/test_docs.py fails
+# when the committed page is stale).
+.PHONY: cli-reference
+cli-reference: setup
+	$(PY) scripts/cli_reference.py > docs/reference/cli.md
+
 # Rewrite every golden shader (every target of implc/targets.py) from the current output;
 # review the diff.
 # Each new text is validated by its real compiler before it is written (an invalid one is
@@ -82,12 +94,13 @@ lint: setup
 	  implc/__init__.py implc/version.py implc/api
 	@for f in $(JS_SOURCES); do node --check $$f || exit 1; done
 
-# The paper's Table 1 into results/ (docs/RESULTS.md). 1024x1024 like the paper: on this
+# The paper's Table 1 into results/, and its tables into docs/RESULTS.md in place. 1024x1024 like the paper: on this
 # 2-core llvmpipe machine the costliest cell (curvature at b = 0.002) takes ~1.3 s a
 # frame, and the whole run (3 surfaces x 4 configurations, 6 frames per cell) ~2 min.
 BENCH_SIZE := 1024
 bench: setup
 	$(PY) -m implc bench cross-cap miter steiner --size $(BENCH_SIZE) --frames 5 -o results/
+	$(PY) scripts/docs_section.py bench results/table.md --write docs/RESULTS.md
 
 # Generated against the hand-written GLSL of templates/baseline/ (Cross-Cap, taylor and
 # hessian), frames taken in turns: paper = taylor b 0.01 and hessian b 0.002, equal = both
@@ -100,7 +113,7 @@ bench-baseline: setup
 	done
 
 # Point versus ray-poly evaluation (accuracy, speed), and the degree sweep (exact against
-# taylor and hessian, degree 2-20, docs/RESULTS.md section 7) with its plot: ~50 minutes.
+# taylor and hessian, degree 2-20, docs/RESULTS.md, "The degree sweep") with its plot: ~50 minutes.
 forms: setup
 	$(PY) scripts/eval_forms.py accuracy --size 512 cross-cap miter steiner roman torus tooth \
 	  sphere kummer cayley clebsch ding-dong whitney-umbrella barth-sextic heart
@@ -108,7 +121,7 @@ forms: setup
 
 # What AMD's compiler makes of the degree sweep (issue 49): RADV's ACO statistics on null
 # devices (no GPU needed) of Chmutov T_2..T_20's programs, every method, float and double,
-# written into docs/RESULTS.md section 10 (scripts/gpu_stats_table.py). About 2 minutes.
+# written into docs/RESULTS.md, "What a GPU's compiler says" (scripts/gpu_stats_table.py). About 2 minutes.
 .PHONY: gpu-stats-table gpu-bench
 gpu-stats-table: setup
 	$(PY) scripts/gpu_stats_table.py --write docs/RESULTS.md
@@ -145,7 +158,7 @@ corpus-interval: setup
 
 # Compile time of every corpus row as a user meets it (`implc compile -e ROW`, default
 # method, GLSL, a fresh process each, two at a time): the distribution and the slowest
-# ten (docs/RESULTS.md section 6). About 2 minutes on 2 cores.
+# ten (docs/RESULTS.md, "Compile time on the corpus"). About 2 minutes on 2 cores.
 compile-times: setup
 	$(PY) scripts/compile_times.py -j 2
 
@@ -155,13 +168,13 @@ compile-times: setup
 startup: setup
 	$(PY) scripts/startup.py
 
-# The README's gallery pictures (docs/gallery-examples.png, docs/gallery-corpus.png):
+# The docs' gallery pictures (docs/gallery-examples.png, docs/gallery-corpus.png):
 # `implc gallery` of the bundled examples and of 24 corpus rows at 96 pixels. About 20 s.
 .PHONY: gallery-pictures
 gallery-pictures: setup
 	$(PY) scripts/gallery_pictures.py
 
-# The README's notebook figure (docs/notebook-widget.png): tests/test_jupyterlab.py's
+# The docs' notebook figure (docs/notebook-widget.png): tests/test_jupyterlab.py's
 # screenshot of the tour's widget cell in JupyterLab. About 30 s.
 .PHONY: notebook-picture
 notebook-picture: setup
@@ -172,4 +185,4 @@ three-picture: setup
 	IMPLC_SCREENSHOTS=docs $(PY) -m pytest tests/test_host_three.py -q -k "torus and webgpu and not webgl2"
 
 clean:
-	rm -rf $(OUT) build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules
+	rm -rf $(OUT) site build dist *.egg-info .pytest_cache .ruff_cache $(NPM_DIR)/node_modules

@@ -15,6 +15,6 @@ with dropped_signals_kept():  # main() raises again a Ctrl-C that Python dropped
 # _Py_UnhandledKeyboardInterrupt flag): Ctrl-C landing while a dataclass or namedtuple is
 # defined in a lazy import, though main() caught it and printed "interrupted"
 # (test_fault[compile-SIGINT], about 1 run in 100 under load). Running an empty string
-# clears the flag, so the process exits with main()'s code (README "Exit codes").
+# clears the flag, so the process exits with main()'s code (docs/reference/errors.md "Exit codes").
 exec("")
 raise SystemExit(code)

@@ -7,7 +7,7 @@ value, every subtraction an addition). Near the surface that error moves the zer
 by about d(p) = 2^-24 M(p) / |grad S(p)|. Where d reaches the distance the counts call
 a wrong root (options.T_TOL), no float32 method can draw the surface right there, and
 the exact method's ray polynomial, an expansion about the chord's middle, rounds worse
-still. Measured (docs/RESULTS.md section 8): on Chmutov's T_n + T_n + T_n the share of
+still. Measured (docs/journal/2026-12-04.md): on Chmutov's T_n + T_n + T_n the share of
 points moved beyond T_TOL is 0 up to degree 14, 1.3 % at 16, 52 % at 18 and 66 % at 20,
 where every method's picture has thousands of wrong pixels; 0 on sums of n-th powers to
 degree 20 and on the gallery rows of issue 21 (corpus rows 137, 163, 244, 247, 285).
@@ -45,7 +45,7 @@ WARN_SHARE = 0.01
 # The ray polynomial's rounding is measured on the view's pixel rays, RAYS a side, its first
 # root found among SAMPLES points of the chord and refined by bisection. From RAY_WARN_SHARE
 # of the rays with a root moved beyond T_TOL, `implc show` warns. Measured (the sweep's
-# default view) against exact's bad pixels at 512^2 (docs/RESULTS.md section 8): Chmutov's
+# default view) against exact's bad pixels at 512^2 (docs/journal/2026-12-04.md): Chmutov's
 # T_12 0.089 % of the rays (exact: 0.074 % of the pixels bad), T_14 0.28 % (0.28 %), T_16
 # 3.5 % (3.2 %), T_18 20 % (16 %), T_11 and T_10 0 (24 and 8 pixels); corpus rows 163, 244,
 # 285, Barth's decic and sums of powers to degree 20: 0; row 247 0.05 % (7 pixels).

@@ -22,7 +22,8 @@ from .functions import FUNCTIONS, Function
 from .limits import Limits
 from .symbols import DIRECTION, POINT
 
-# Resource bound (README "Limits"): the estimated size, in expression-tree nodes, of every
+# Resource bound (docs/reference/errors.md "Limits"): the estimated size, in expression-tree nodes,
+# of every
 # quantity a marcher may ask for (S, the gradient, F', F'' and the Laplacian) before CSE.
 # sympy's differentiation and `cse` take time roughly proportional to it (about 20-50 us
 # a node here); the largest corpus row (a degree-18 torus knot) estimates ~340,000.

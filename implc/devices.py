@@ -3,7 +3,8 @@ built programs) and one wgpu device per process.
 
 Both stages compile the same shader text on the same driver (`implc compile --validate`
 then `render`, a golden's build then its render), so the sessions sit below both of them
-(README "Architecture") instead of in one stage and imported by the other. Opening them
+(docs/explanation/architecture.md "Layers") instead of in one stage and imported by the
+other. Opening them
 costs 0.1-0.5 s, hence one each per process; a missing driver is a `ToolError`.
 """
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import unicodedata
 from dataclasses import dataclass
 
-# Documented exit codes (README "Exit codes").
+# Documented exit codes (docs/reference/errors.md "Exit codes").
 EXIT_OK = 0
 EXIT_INPUT = 1  # the equation, a surface file or a parameter is wrong
 EXIT_USAGE = 2  # the command line is wrong (argparse uses 2 as well)

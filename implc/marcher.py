@@ -118,7 +118,8 @@ def choose_form(method: Method, expr: sympy.Expr, requested: str = "auto",
     polynomial, the interval method at points. A marcher takes what is asked, and under
     `auto` ray-poly where its march step evaluates fewer operations (step_ops) and the
     degree is at most AUTO_RAY_POLY_MAX_DEGREE (where it measured as accurate), else point:
-    the faster form on every surface timed in both (docs/RESULTS.md section 2)."""
+    the faster form on every surface timed in both
+    (docs/journal/2026-12-01-marcher-and-forms.md)."""
     if requested not in EVAL_CHOICES:
         raise InputError(f"unknown evaluation form '{requested}'; choose from "
                          f"{', '.join(EVAL_CHOICES)}")

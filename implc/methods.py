@@ -81,7 +81,8 @@ def interval_test(start: sympy.Expr, *values: sympy.Expr, late: sympy.Expr = F1)
     floats rounds to 0 only when it is 0), so the boolean is that of v evaluated as
     F1 + w. F1 is the last value a march step computes; as a bound F1 is one comparison
     from the answer, not a sum, a product and a reduction: 7-12 % a frame on llvmpipe for
-    the one reduction, and 4-10 % more for the bound (docs/RESULTS.md, section 3)."""
+    the one reduction, and 4-10 % more for the bound
+    (docs/journal/2026-12-01-marcher-and-forms.md)."""
     sigma = sympy.sign(start)
 
     def signed(v: sympy.Expr) -> sympy.Expr:  # sign(F0)*v, term by term (also exact)
@@ -199,7 +200,7 @@ METHODS: dict[str, Method] = {
                # F' is sampled with F, though Eq. 2 reads it only near the surface:
                # evaluated inside the step rule, on the branch that reads it, it was on
                # the loop's chain (a masked branch costs every lane) and measured 10-40 %
-               # slower a frame (docs/RESULTS.md, section 3)
+               # slower a frame (docs/journal/2026-12-01-marcher-and-forms.md)
                (F(S), DF(S), sympy.S.Zero), eq2(F0, D0),
                Rule(F0 * F1 < 0, what="the sign test: F changes sign between the ends")),
         Method("taylor", "Eq. 2 steps; first-order Taylor interval test (Eq. 3)",

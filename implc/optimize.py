@@ -160,7 +160,8 @@ def _sums_by_depth(assignments, outputs, inputs):
     the printers keep the grouping), the two shallowest terms first, as Huffman's code
     merges the two lightest. GPU compilers keep the order a sum is written in (floating
     point addition is not associative), and a march step is bound by its dependency
-    chain (docs/RESULTS.md, section 3): the Cross-Cap's S ends in `t0 + (x_2 + z)`, not
+    chain (docs/journal/2026-12-01-marcher-and-forms.md): the Cross-Cap's S ends in `t0 + (x_2 +
+    z)`, not
     `t0 + x_2 + z`. Ties keep sympy's canonical order, so the output stays
     deterministic."""
     return _arrange(assignments, outputs, dict.fromkeys(inputs, 0), products=False)

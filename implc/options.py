@@ -23,12 +23,14 @@ EVAL_CHOICES = ("auto", *FORMS)
 # measured those of point evaluation to a few pixels (bundled polynomials, the sweeps,
 # corpus rows 137, 163, 244 and 285 at 512^2), but on the degree-14 knot of corpus row 247
 # F' and F'' from the ray's coefficients made taylor 1,850 / 0 / 657 against point's
-# 309 / 0 / 75, and hessian 1,398 / 0 / 497 against 58 / 0 / 3 (docs/RESULTS.md section 2)
+# 309 / 0 / 75, and hessian 1,398 / 0 / 497 against 58 / 0 / 3
+# (docs/journal/2026-12-01-marcher-and-forms.md)
 AUTO_RAY_POLY_MAX_DEGREE = 12
 
 # The exact method's highest degree. Float32 root isolation through the expanded ray
 # polynomial loses accuracy with the degree and the coefficients' size; measured at 512^2
-# (docs/RESULTS.md section 8): 9 bad pixels of 262,144 on the degree-14 knot and 3 on the
+# (docs/journal/2026-12-02-every-degree.md): 9 bad pixels of 262,144 on the degree-14 knot and 3 on
+# the
 # degree-18 one, 0-5 on the gallery rows of degree 10-12, but thousands on Chmutov's
 # surfaces from degree 13 (coefficients up to 2^(n-1), where every method fails).
 EXACT_MAX_DEGREE = 20

@@ -179,7 +179,7 @@ def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
       rounds least;
     - in double, each p_j by its own Horner's rule, in v^2 where its powers are all even
       or all odd (Chmutov's T_n, x^n sums): half the steps, and independent chains.
-    Measured on Chmutov's T_n sums at 512^2 (docs/RESULTS.md section 8), against Horner's
+    Measured on Chmutov's T_n sums at 512^2 (docs/journal/2026-12-05.md), against Horner's
     loop: frames 0.93-0.97 at T13-T18 in float32 with fewer wrong roots (T16 8,303 ->
     7,509 of 262,144); in double the division 0.93-0.97 at T18 and T20, the parity
     Horner 0.94-0.98 of that (0.88-0.92 of the loop), 0 / 0 / 0 kept. In float32 the
@@ -304,7 +304,7 @@ def estrin(coefficients: Sequence[sympy.Expr], x: sympy.Symbol,
     dependency chain is about 2 log2(n) operations where Horner's is 2n (GPU compilers,
     llvmpipe among them, keep a*b + c as two operations), and a march step is bound by its
     chain: with the march point of values_at (_MARCH_POINT), 2-6 % a frame
-    (docs/RESULTS.md, section 3).
+    (docs/journal/2026-12-01-marcher-and-forms.md).
 
     A term's integer weight is multiplied onto the power of x it meets where it meets one,
     c3*(2.0*x), not onto its coefficient: in a march loop the coefficients are loop

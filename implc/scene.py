@@ -104,7 +104,7 @@ def shading_for(view: View) -> Shading:
 #
 # The command line's view options (`--radius --center --eye --look-at --up --fov`, the
 # [view] keys; --look-at is `target`) override the file's values one by one. What neither sets is
-# chosen (README "Framing"):
+# chosen (docs/guide/command-line.md "Framing"):
 # - no `radius`: the clip sphere is the surface's, found by sampling S
 #   (implc/extent.py), centred on it (or on `center`); when no surface is found the
 #   default view is kept and the caller says so;

@@ -40,7 +40,7 @@ from .raypoly import (
 # (Descartes' rule of signs on the Bernstein coefficients of a node, stackless: the next
 # node follows from the current one) instead of the critical points level by level: it
 # visits 2-6 nodes a ray on average and stops at the first root, where the levels find every root
-# of every derivative. Measured at 512^2 (docs/RESULTS.md section 8), exact / taylor:
+# of every derivative. Measured at 512^2 (docs/journal/2026-12-02-every-degree.md), exact / taylor:
 # degree 5-6 with the levels 0.84-1.03 (Taubin's heart, Barth's sextic, x^6 + y^6 + z^6),
 # with Bernstein 0.41-0.46 and no more bad pixels (the heart 10 of 262,144 against the
 # levels' 15) since each node's ends are F's robust values (see templates/solver.j2); at
@@ -67,7 +67,7 @@ BERNSTEIN_MAX_NODES = 96
 # node at its left end that still holds its control polygon's first sign change (b_(i-1),
 # b_i with i/n < 2^-L), where F's first root most likely is; skipping a level's left
 # half costs a node either way, and the stackless walk moves up again by itself. Measured
-# at 512^2 (docs/RESULTS.md section 8): nodes a ray on Chmutov's T18 in double 4.46 ->
+# at 512^2 (docs/journal/2026-12-04-night.md): nodes a ray on Chmutov's T18 in double 4.46 ->
 # 3.88, frames 0.89-0.95 of one level at a time on T12-T20, x^18 sums unchanged; up to 2
 # levels about the same, 4 worse.
 DESCENT_LEVELS = 3
@@ -80,7 +80,7 @@ DESCENT_LEVELS = 3
 # halved again. Simulated (scripts/walk_sim.py, 64^2): the SIMD block's most nodes on
 # Chmutov's T18 7.06 -> 5.86, T12 5.86 -> 5.08, T20 7.36 -> 6.13, x^18 sums 1.91 -> 1.71;
 # factors 2, 3, 5 and 8 gave 8.10, 6.38, 5.92 and 6.61 on T18. Measured at 512^2
-# (docs/RESULTS.md section 8): frames 0.90-0.97 of the widest next node.
+# (docs/journal/2026-12-04-night.md): frames 0.90-0.97 of the widest next node.
 NEXT_REACH = 4
 NEXT_HALVINGS = 4
 NEXT_FLOOR = 4
@@ -91,7 +91,7 @@ NEXT_FLOOR = 4
 # FIRST_HALVINGS halvings (to 1/16 of the chord). Simulated (scripts/walk_sim.py, 64^2),
 # the SIMD block's most nodes after the rules above: Chmutov's T18 5.86 -> 5.29, T12 5.08
 # -> 4.80, T20 6.14 -> 5.57, x^18 sums 1.71 -> 1.79; factors 4, 16 and 32 gave 5.52, 5.73
-# and 5.82 on T18. Measured at 512^2 (docs/RESULTS.md section 8): frames 0.92-0.96 on
+# and 5.82 on T18. Measured at 512^2 (docs/journal/2026-12-04-night.md): frames 0.92-0.96 on
 # Chmutov. (F' from the ray's coefficients by Estrin's scheme instead made x^9 and x^10
 # sums and T5 1.35x slower with the same nodes, pixel for pixel: llvmpipe's code for the
 # walk's loop, not the walk.)
@@ -235,7 +235,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     # 512^2, exact / taylor 2-10 % lower (x^18 sums 0.73 -> 0.68, Chmutov T18 1.24 ->
     # 1.11, T12 0.72 -> 0.71, corpus rows 137 0.44 -> 0.41 and 244 0.57 -> 0.54), and the
     # same false / missed / wrong-root counts on T12, x^12 sums and rows 137, 163, 244,
-    # 247 and 285 (docs/RESULTS.md section 8)
+    # 247 and 285 (docs/journal/2026-12-03.md)
     functions.append(_value_function(f"P{n}", n, printer, prefix, carried,
                                      certain_first=not bernstein))
     c = [sym(f"ray.c{k}") for k in range(n + 1)]

@@ -5,9 +5,10 @@ A target is its printer (implc/backends/<name>.py, which also holds its function
 spellings), its templates (templates/<name>/), the file extensions
 `implc validate` reads as its language, the validator that runs its real compiler, the
 render backends that run its program, and its flavours and precisions. Adding a target
-is one record here plus those files (README "Adding a target").
+is one record here plus those files (CONTRIBUTING.md "Adding a target").
 
-Layering (README "Architecture"): the registry sits below emit, which reads the printer,
+Layering (docs/explanation/architecture.md "Layers"): the registry sits below emit, which
+reads the printer,
 templates, flavours and precisions from it. The validator and the runners sit above emit
 (they compile and run what emit writes), so a record names them as "module:function"
 strings, imported by `resolve` when they are called; the printers too ("module:Class"),

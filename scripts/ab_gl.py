@@ -6,7 +6,7 @@
 Programs are implc GLSL 330 programs (uniforms u_resolution, u_eye, ...); the camera is
 the surface's [view] (--surface, default cross-cap). Timed frames are interleaved (A, B,
 C, A, B, C, ...) so that machine noise hits every program alike; each ends in glFinish.
-Used for the old-versus-new measurements of issue 9 (docs/RESULTS.md).
+Used for the old-versus-new measurements of issue 9 (docs/journal/2026-12-01-marcher-and-forms.md).
 """
 
 from __future__ import annotations

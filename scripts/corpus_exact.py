@@ -1,6 +1,6 @@
 """`-m exact` over the corpus: every polynomial row that loads compiles and validates with
 the exact method on glsl, wgsl and opencl, or is refused with the documented degree
-reason (docs/RESULTS.md, "The exact method on the corpus").
+reason (docs/journal/2026-12-01-exact-and-table-1.md, "Corpus").
 
     python scripts/corpus_exact.py [TSV] [-j 2]
 """

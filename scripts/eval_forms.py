@@ -42,7 +42,7 @@ from implc.render.run import open_runner  # noqa: E402
 FORMS = ("point", "ray-poly")
 # The sweep compiles each program COPIES times and times them all in the same rounds,
 # keeping the faster copy's median: llvmpipe at times runs one compiled program about
-# 1.4x slower in every frame of a run (docs/RESULTS.md section 8), a compile's lot, not
+# 1.4x slower in every frame of a run (docs/journal/2026-12-05.md), a compile's lot, not
 # the program's. The first copy's compile is the one reported (emit, driver).
 COPIES = 2
 
@@ -230,7 +230,7 @@ def precision(degrees: list[int], size: int, frames: int,
               plot: str | None = None) -> None:
     """exact and taylor (`--eval auto`), each in float (`gl`) and in double (`gl-double`),
     timed in the same rounds, with their counts against the reference unless `counts` is
-    False (docs/RESULTS.md, "Double precision in GLSL" and "Both methods in double");
+    False (docs/journal/2026-12-04.md, "Double precision in GLSL", "Both methods in double");
     `plot`: exact / taylor in each precision against the degree, drawn there."""
     rows = []
     names = [f"{method} {'double' if backend.endswith('double') else 'float'}"

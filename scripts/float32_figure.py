@@ -1,5 +1,5 @@
 """Why the sweep's Chmutov rows miss 0.67 in float32 from degree 17: a picture
-(docs/float32-chmutov.png, docs/RESULTS.md section 8).
+(docs/float32-chmutov.png, docs/RESULTS.md, "The degree sweep").
 
     python scripts/float32_figure.py --degree 20 --size 384 -o docs/float32-chmutov.png
 

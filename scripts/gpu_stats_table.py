@@ -12,10 +12,10 @@ double (GLSL 450; HLSL has float only). About 2 minutes.
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 from pathlib import Path
 
+from docs_section import replace_marked
 from eval_forms import _degrees, sweep_equations
 
 import implc
@@ -26,7 +26,7 @@ METHODS = ("exact", "taylor", "hessian", "interval")
 TABLED = ("exact", "taylor")  # the methods of the per-degree table
 # (target, flavour, precision): the programs that reach SPIR-V; the first is tabled
 PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"), ("glsl", "450", "double"))
-BEGIN, END = "<!-- gpu-stats:begin -->", "<!-- gpu-stats:end -->"
+MARKER = "gpu-stats"  # <!-- gpu-stats:begin --> ... <!-- gpu-stats:end -->
 
 
 def measure(degrees: list[int], families: list[str]) -> dict:
@@ -78,7 +78,7 @@ def main() -> None:
     ap.add_argument("--degrees", default="2-20")
     ap.add_argument("--families", default=",".join(GPU_FAMILIES))
     ap.add_argument("--write", metavar="MARKDOWN",
-                    help=f"replace the text between {BEGIN} and {END} in this file")
+                    help=f"replace the text between the {MARKER} markers in this file")
     args = ap.parse_args()
     degrees, families = _degrees(args.degrees), args.families.split(",")
     command = " ".join(["python scripts/gpu_stats_table.py", *sys.argv[1:]])
@@ -86,12 +86,7 @@ def main() -> None:
     if not args.write:
         print(text)
         return
-    path = Path(args.write)
-    page = path.read_text(encoding="utf-8")
-    span = re.compile(re.escape(BEGIN) + ".*?" + re.escape(END), re.S)
-    if not span.search(page):
-        sys.exit(f"{path} has no {BEGIN} ... {END} part to replace")
-    path.write_text(span.sub(lambda _: f"{BEGIN}\n{text}{END}", page), encoding="utf-8")
+    replace_marked(Path(args.write), MARKER, text)
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@ SIMD group pays), for the plain walk (one level a descent, the widest next node 
 skip, the chord's left half first), the shipped rules added one by one
 (solver.DESCENT_LEVELS, NEXT_HALVINGS, FIRST_HALVINGS) and the lower bound: the fewest
 nodes any rule could visit, the dyadic cover of the chord up to the first root by nodes
-that Descartes' rule proves root-free, and the root's node (docs/RESULTS.md section 8).
+that Descartes' rule proves root-free, and the root's node (docs/journal/2026-12-04-night.md).
 
     python scripts/walk_sim.py "x^18 + y^18 + z^18 - 1 = 0" --size 64
 """

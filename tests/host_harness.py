@@ -140,8 +140,8 @@ def assert_same(got: RenderResult, expected: RenderResult, label: str) -> None:
 
 
 def save_shot(color: np.ndarray, name: str) -> None:
-    """With IMPLC_SCREENSHOTS=DIR, the node's picture as DIR/name (README's pictures of
-    the hosts: docs/host-*.png), as tests/browser_support.py keeps its screenshots."""
+    """With IMPLC_SCREENSHOTS=DIR, the node's picture as DIR/name (the hosts guide's
+    pictures, docs/host-*.png), as tests/browser_support.py keeps its screenshots."""
     keep = os.environ.get("IMPLC_SCREENSHOTS")
     if keep:
         from PIL import Image

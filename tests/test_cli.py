@@ -634,11 +634,11 @@ def test_unexpected_exception_is_an_internal_error(debug):
 
 
 def test_exit_codes_are_documented():
-    """The README's exit-code table names every code the CLI can return."""
+    """The exit-code table (docs/reference/errors.md) names every code the CLI can return."""
     from implc import errors
 
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    table = readme[readme.index("### Exit codes"):]
+    page = (ROOT / "docs" / "reference" / "errors.md").read_text(encoding="utf-8")
+    table = page[page.index("## Exit codes"):]
     table = table[: table.index("\n## ")]
     for name in ("EXIT_OK", "EXIT_INPUT", "EXIT_USAGE", "EXIT_INVALID", "EXIT_TOOL",
                  "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_TERMINATED"):

@@ -1,6 +1,6 @@
 """Options a new user types (issue 23): none is ignored, a bad one is a usage error.
 
-One rule (README "Exit codes"): a bad command line exits 2 with one line,
+One rule (docs/reference/errors.md "Exit codes"): a bad command line exits 2 with one line,
 `implc COMMAND: error: ...`, and a pointer to `implc COMMAND --help` (not the whole
 usage); bad input (the equation, a file, a parameter, an output path) exits 1.
 """

@@ -2,7 +2,8 @@
 
 Faults: a missing input, an unreadable input, a directory where a file is expected, an
 unwritable output, a full disk (RLIMIT_FSIZE), SIGINT and SIGTERM. Each must end with its
-documented exit code (README "Exit codes": 1 for the file faults, 130 for SIGINT, 143
+documented exit code (docs/reference/errors.md "Exit codes": 1 for the file faults, 130 for SIGINT,
+143
 for SIGTERM), one line on stderr without a traceback, and no partial output: no output
 file, no temporary file, no staging directory.
 

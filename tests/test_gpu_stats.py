@@ -10,7 +10,8 @@ below degree 10. `make test` samples degrees
     IMPLC_GPU_DEGREES=2-20 pytest tests/test_gpu_stats.py
 
 Double (GLSL 450) does spill from degree 10 on gfx1100 (and 6 SGPRs of exact from 12 on
-navi21); scripts/gpu_stats_table.py measures and lists it (docs/RESULTS.md section 10).
+navi21); scripts/gpu_stats_table.py measures and lists it (docs/RESULTS.md, "What a GPU's compiler
+says").
 """
 
 from __future__ import annotations
@@ -34,7 +35,8 @@ BUNDLED = ("barth-decic", "barth-sextic", "clebsch")
 ROOT = Path(__file__).resolve().parent.parent
 # the float programs that reach SPIR-V: (target, flavour, precision)
 PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
-# double (GLSL 450) spills from degree 10 on gfx1100 (docs/RESULTS.md section 10): guarded
+# double (GLSL 450) spills from degree 10 on gfx1100 (docs/RESULTS.md, "What a GPU's compiler
+# says"): guarded
 # below that, on the sampled degrees and the bundled sextic
 DOUBLE = (("glsl", "450", "double"),)
 DOUBLE_SURFACES = ("chmutov 2", "chmutov 4", "chmutov 8", "barth-sextic")

@@ -11,7 +11,7 @@ that value; and a red box through the torus hides it and is hidden by it where e
 front (the surface's depth), as in tests/test_browser.py's three.js test.
 
 With IMPLC_SCREENSHOTS=DIR, the WebGPU picture with the box is saved as DIR/host-three.png:
-the README's figure is made by `make three-picture` (IMPLC_SCREENSHOTS=docs).
+the hosts guide's figure is made by `make three-picture` (IMPLC_SCREENSHOTS=docs).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ declared as locals first: templates/hosts/unity/harness.hlsl.j2), compiled by tw
 front ends (glslang and Slang) and rendered through SPIR-V, against implc's own GL render
 of the same view: SSIM >= 0.99 and hit masks agreeing on >= 99.5 % of the pixels (the
 browser tests' bounds, tests/test_browser.py), t within 1e-4 where both hit.
-Unity itself does not run here (README "Unity (Shader Graph)")."""
+Unity itself does not run here (docs/guide/hosts.md "Unity (Shader Graph)")."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from host_harness import (
 
 from implc.emit import param_uniforms
 
-SHOT = "host-unity.png"  # README's picture (docs/), kept with IMPLC_SCREENSHOTS=DIR
+SHOT = "host-unity.png"  # docs/guide/hosts.md's picture, kept with IMPLC_SCREENSHOTS=DIR
 
 
 @pytest.mark.parametrize("front", FRONT_ENDS)

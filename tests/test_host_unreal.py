@@ -5,7 +5,7 @@ inout additional outputs...) { <Code> }`, the .ush from Include File Paths #incl
 first, Unreal's types defined minimally: templates/hosts/unreal/harness.hlsl.j2),
 compiled by two HLSL front ends (glslang and Slang) and rendered through SPIR-V, against
 implc's own GL render of the same view, with tests/test_host_unity.py's bounds.
-Unreal itself does not run here (README "Unreal Engine (Custom node)")."""
+Unreal itself does not run here (docs/guide/hosts.md "Unreal Engine (Custom node)")."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ from host_harness import (
 
 from implc.emit import param_uniforms
 
-SHOT = "host-unreal.png"  # README's picture (docs/), kept with IMPLC_SCREENSHOTS=DIR
+SHOT = "host-unreal.png"  # docs/guide/hosts.md's picture, kept with IMPLC_SCREENSHOTS=DIR
 
 
 def unreal_harness(tmp_path, example: str) -> tuple[str, object, list]:

@@ -2,7 +2,8 @@
 input located in the file, written back (round trip), and `implc gallery`.
 
 The framing against jsurf itself (hit-pixel fraction within 2 % of jsurf's own picture)
-was measured once with jsurf built from its source (README "SURFER files"); here the
+was measured once with jsurf built from its source (docs/guide/surfer-and-gallery.md "SURFER
+files"); here the
 orthographic sphere of kugel.jsurf is checked against its exact picture instead.
 """
 

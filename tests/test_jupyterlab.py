@@ -14,7 +14,7 @@ temporary directory, the server's start within SERVER_START_S, each browser wait
 browser_support.TIMEOUT_MS; the server is stopped (its process group) whatever happens.
 
 With IMPLC_SCREENSHOTS=DIR the widget's cell is saved as DIR/notebook-widget.png: the
-README's figure is made by `make notebook-picture` (IMPLC_SCREENSHOTS=docs).
+docs/guide/python.md's figure is made by `make notebook-picture` (IMPLC_SCREENSHOTS=docs).
 """
 
 from __future__ import annotations

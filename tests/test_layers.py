@@ -1,6 +1,7 @@
-"""The layering of README "Architecture": no module imports from a higher layer.
+"""The layering of docs/explanation/architecture.md "Layers": no module imports from a
+higher layer.
 
-The layer of each module is read from the README's table, so the statement and the check
+The layer of each module is read from that page's table, so the statement and the check
 cannot drift apart. Every `import` in implc/ counts, function-local ones included. A
 module may import from a lower layer, or from its own layer inside its own package
 (render/run.py uses render/reference.py; a package's __init__.py, front/__init__.py, is
@@ -19,7 +20,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "implc"
-README = ROOT / "README.md"
+PAGE = ROOT / "docs" / "explanation" / "architecture.md"
 
 
 def module_name(path: Path) -> str:
@@ -29,10 +30,10 @@ def module_name(path: Path) -> str:
 
 
 def stated_layers() -> dict[str, int]:
-    """Module -> layer, from the table under README "### Layers" (`file.py` cells)."""
-    text = README.read_text(encoding="utf-8")
-    section = text.split("### Layers", 1)
-    assert len(section) == 2, "README.md has no '### Layers' section"
+    """Module -> layer, from the table under the page's "## Layers" (`file.py` cells)."""
+    text = PAGE.read_text(encoding="utf-8")
+    section = text.split("\n## Layers\n", 1)
+    assert len(section) == 2, f"{PAGE.name} has no '## Layers' section"
     layers: dict[str, int] = {}
     for line in section[1].splitlines():
         match = re.match(r"\|\s*(\d+)\s*\|([^|]*)\|", line)
@@ -42,7 +43,7 @@ def stated_layers() -> dict[str, int]:
             continue
         for cell in re.findall(r"`([\w/]+\.py)`", match.group(2)):
             name = module_name(PACKAGE / cell)
-            assert name not in layers, f"README lists {cell} in two layers"
+            assert name not in layers, f"{PAGE.name} lists {cell} in two layers"
             layers[name] = int(match.group(1))
     return layers
 
@@ -73,9 +74,9 @@ def violations() -> list[str]:
     layers = stated_layers()
     files = sorted(PACKAGE.rglob("*.py"))
     known = {module_name(p) for p in files}
-    problems = [f"{module_name(p)} has no layer in README.md '### Layers'"
+    problems = [f"{module_name(p)} has no layer in {PAGE.name} '## Layers'"
                 for p in files if module_name(p) not in layers]
-    problems += [f"README.md '### Layers' lists {m}, which does not exist"
+    problems += [f"{PAGE.name} '## Layers' lists {m}, which does not exist"
                  for m in sorted(set(layers) - known)]
     for path in files:
         importer = module_name(path)

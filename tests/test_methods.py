@@ -55,7 +55,7 @@ def test_extremum_matches_the_exact_reference(example):
 @pytest.mark.parametrize("target", ["glsl", "wgsl", "opencl"])
 def test_min_and_max_print_as_balanced_trees(target):
     """A root test's min/max over four values is two levels deep, not three: the march
-    loop is bound by its dependency chain (docs/RESULTS.md, generated vs hand-written)."""
+    loop is bound by its dependency chain (docs/journal/2026-12-01-marcher-and-forms.md)."""
     a, b, c, d, e = sympy.symbols("a b c d e", real=True)
     printer = get_target(target).printer()
     name = printer.known_functions["Max"]
@@ -69,7 +69,7 @@ def test_min_and_max_print_as_balanced_trees(target):
 def test_root_test_takes_the_end_sample_last(target):
     """The end sample (F1, F1') is what a march step computes last: F1 is one comparison
     from the root test's answer, F1' one product (optimize.arrange_by_depth), and the
-    values free of F1 are one min (docs/RESULTS.md, section 3)."""
+    values free of F1 are one min (docs/journal/2026-12-01-marcher-and-forms.md)."""
     printer = get_target(target).printer()
     sign, high = printer.known_functions["sign"], printer.known_functions["Max"]
     for method in ("taylor", "hessian"):

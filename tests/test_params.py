@@ -2,7 +2,7 @@
 
 - the symbolic expression is the substituted one once the values are put back (every
   bundled example with parameters, numerically at seeded random points);
-- every uniform emit validates with its real compiler, and declares what the README says;
+- every uniform emit validates with its real compiler, and declares what the drop-in page says;
 - OpenCL threads them as a Params argument: its emits validate, and a user kernel that
   pastes the library passes new values per launch and lands on the torus's exact roots;
 - a runner opened once renders new parameter values through set_params without compiling
@@ -202,7 +202,7 @@ def test_cli_render_and_compile_take_params(tmp_path):
                  "--size", "32", "-o", str(out))
     assert proc.returncode == 0, proc.stderr
     proc = implc("compile", "torus", "--params", "uniform", "--flavor", "shadertoy")
-    # contradicting options: exit 2, the README's table (issue 44; it was 1)
+    # contradicting options: exit 2, the exit-code table (issue 44; it was 1)
     assert proc.returncode == 2 and "shadertoy" in proc.stderr
     assert proc.stderr.startswith("implc compile: error: --params uniform: the shadertoy")
 
@@ -210,7 +210,7 @@ def test_cli_render_and_compile_take_params(tmp_path):
 USER_KERNEL = """
 __kernel void hits(__global const float* z0, __global float* t_out, float R, float r) {
     int i = get_global_id(0);
-    to_Params params = {R, r};  // the README's drop-in lines
+    to_Params params = {R, r};  // the drop-in page's lines
     float t;
     bool hit = to_intersect((float3)(-3.0f, 0.0f, z0[i]), (float3)(1.0f, 0.0f, 0.0f),
                             0.0f, 6.0f, &t, params);

@@ -1,6 +1,7 @@
 """Issue 44, point 6: a portrait picture keeps the sides.
 
-The field of view spans the picture's shorter side (README "Camera and pixels"): a
+The field of view spans the picture's shorter side (docs/reference/drop-ins.md "Camera and
+pixels"): a
 portrait render is the square render with more rows above and below, never a cut-down
 one. Before, every camera kept the vertical field of view, so `render torus --width 600
 --height 700` cut the torus left and right. Renders on every backend this machine has,

@@ -227,10 +227,11 @@ def _wgsl_layout(struct: str) -> tuple[list[tuple[str, int]], int]:
 
 
 def test_readme_rust_uniforms_match_the_wgsl_layout():
-    """The README's `#[repr(C)]` Rust struct (wgpu / Bevy section) puts every field of the
-    torus's `--params uniform` WGSL `Uniforms` at its byte offset, and has its size."""
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = readme.split("### wgpu / Bevy-style bind groups", 1)[1]
+    """The `#[repr(C)]` Rust struct of docs/guide/pasting.md (wgpu / Bevy section) puts
+    every field of the torus's `--params uniform` WGSL `Uniforms` at its byte offset, and
+    has its size."""
+    page = (ROOT / "docs" / "guide" / "pasting.md").read_text(encoding="utf-8")
+    section = page.split("## wgpu / Bevy-style bind groups", 1)[1]
     rust = re.search(r"struct Uniforms \{(.*?)\n\}", section, re.S).group(1)
     offset, rust_fields = 0, {}
     for name, count in re.findall(r"(\w+): (?:f32|\[f32; (\d)\])", rust):

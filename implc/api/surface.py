@@ -62,7 +62,8 @@ class Surface:
     @classmethod
     def load(cls, path: str | Path, *, params: Mapping[str, object] | None = None,
              limits: Limits | None = None) -> Surface:
-        """A surface file: TOML (README "Surface files") or SURFER's `.jsurf`."""
+        """A surface file: TOML (docs/reference/input-language.md "Surface files") or SURFER's
+        `.jsurf`."""
         return cls._make(str(path), None, _param_args(params), limits)
 
     @classmethod

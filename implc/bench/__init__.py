@@ -17,7 +17,8 @@ Configurations:
 - `taylor2`: hessian and hessian-approx with `taylor2 = "consistent"` (h^2/8, F''(t1) in r)
   at the paper's constants, with taylor (which has no F'' term, so is unchanged) timed
   again beside them: a ratio is only fair between frames taken in turns, close in time;
-- `extremum`: the same with `taylor2 = "extremum"`, implc's own test (README "The methods").
+- `extremum`: the same with `taylor2 = "extremum"`, implc's own test (docs/explanation/methods.md
+"The methods").
 
 Outputs in the directory: table.md, table.json, figure.png (the first configuration,
 `paper` by default, laid out like the paper's Fig. 2), figure-<config>.png for the others,

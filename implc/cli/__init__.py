@@ -5,7 +5,8 @@ API only when it runs, so `--help` loads no sympy), the parser in
 `parser.py`, the arguments several commands share in `args.py`, and process handling and
 the mapping of exceptions to exit codes in `process.py` and `main` below, nowhere else.
 
-Exit codes (README "Exit codes"): 0 ok; 1 bad input or output (equation, surface file,
+Exit codes (docs/reference/errors.md "Exit codes"): 0 ok; 1 bad input or output (equation, surface
+file,
 parameter, a missing or unreadable input, an output that cannot be written, a full disk);
 2 bad command line; 3 a shader failed validation; 4 a tool or runtime is missing or
 failed; 70 internal error (a bug: rerun with IMPLC_DEBUG=1 for the traceback);

@@ -68,7 +68,7 @@ VIEW_ABOUT = (
     "stands it up. What neither the file nor an option sets is chosen and printed: "
     "without a radius (every -e) implc finds where S changes sign and puts the clip "
     "sphere around it; without an eye (unless the file sets radius) the camera goes where "
-    "the sphere fills the picture (README \"Framing\").")
+    "the sphere fills the picture (the docs' \"Framing\").")
 
 # Constants field -> (argparse dest, the option that sets it); ranges are checked by the
 # options' types (a bad value is a usage error)
@@ -91,7 +91,7 @@ def surface_args(p: argparse.ArgumentParser) -> None:
 
 
 def limit_args(p: argparse.ArgumentParser) -> None:
-    limits = p.add_argument_group("limits (hostile-input guards; README \"Limits\")")
+    limits = p.add_argument_group("limits (hostile-input guards; the docs' \"Limits\")")
     defaults = Limits()
     for flag, text in LIMIT_FLAGS.items():
         default = getattr(defaults, flag[2:].replace("-", "_"))
@@ -152,7 +152,7 @@ def method_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-m", "--method", choices=list(METHOD_NAMES), default=None,
                    help="root-finding method (default: exact for polynomial surfaces up to "
                         f"degree {EXACT_MAX_DEGREE}, else interval where every function has "
-                        "an interval rule (not atan2), else hessian); see README \"The "
+                        "an interval rule (not atan2), else hessian); see the docs' \"The "
                         "methods\"")
     d = Constants()
     c = p.add_argument_group(
@@ -179,7 +179,7 @@ def method_args(p: argparse.ArgumentParser) -> None:
         "ray-poly (polynomial S: the ray polynomial's coefficients once per ray, then "
         "Estrin's scheme), auto (default: ray-poly up to degree "
         f"{AUTO_RAY_POLY_MAX_DEGREE} where its march step evaluates fewer operations, as "
-        "`implc show` prints, else point); see README \"Evaluation forms\""))
+        "`implc show` prints, else point); see the docs' \"Evaluation forms\""))
 
 
 # --- value types -----------------------------------------------------------------------
@@ -330,7 +330,7 @@ def _spoken(flags: list[str]) -> str:
 def warn_ignored(args: argparse.Namespace, method: str, reference: bool = False) -> None:
     """A method constant the method does not read (--step with exact), or any method
     option with the CPU reference, is said on stderr and ignored (exit 0), never dropped
-    silently (README "Command line"). What a method reads comes from its data
+    silently (docs/guide/command-line.md "Command line"). What a method reads comes from its data
     (`Method.reads`), not from a list here."""
     given = constants_given(args)
     if reference:

@@ -44,7 +44,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.output / 'index.html'} ({len(cells)} "
           f"surface{'' if len(cells) == 1 else 's'}"
           + (f", {failed} failed: see their cells" if failed else "") + ")")
-    if failed:  # the sheet is written, but not every surface is on it (README "Exit codes")
+    if failed:  # the sheet is written, but not every surface is on it (docs/reference/errors.md
+    # "Exit codes")
         print(f"implc gallery: error: {failed} of {len(cells)} surfaces failed (their errors "
               "are in their cells)", file=sys.stderr)
         return EXIT_INPUT

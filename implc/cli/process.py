@@ -1,5 +1,5 @@
 """The process around a command: signals, a guarded standard output, and the one place an
-exception becomes a message and an exit code (README "Exit codes")."""
+exception becomes a message and an exit code (docs/reference/errors.md "Exit codes")."""
 
 from __future__ import annotations
 

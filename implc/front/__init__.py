@@ -12,7 +12,7 @@ sympy nodes built directly (`Add`, `Mul`, `Pow`, `Rational(p, q)`, and the const
 that is well formed but too large) located at the offending span; no other exception
 escapes for any input string.
 
-The language (README "The input language"):
+The language (docs/reference/input-language.md "The input language"):
 
 - numbers `2`, `0.5`, `.5`, `1e-3`, `2E+4`, read exactly (`0.1` is 1/10). A number followed
   by `e` and digits is scientific notation (`2e-3` is 0.002); otherwise `e` is the

@@ -2,7 +2,8 @@
 and the front/back colours (the file's syntax: `jsurf_properties`; its equation's grammar:
 `jsurf_grammar`; writing one: `jsurf_write`).
 
-The view (README "SURFER files"): jsurf maps camera space to its clipping space by
+The view (docs/guide/surfer-and-gallery.md "SURFER files"): jsurf maps camera space to its clipping
+space by
 `transform_matrix * rotation_matrix * camera_transform^-1` and clipping space to the
 surface's by `surface_transform_matrix * 10^scale_factor`; the clip sphere is the unit
 sphere of clipping space. A perspective camera (`PERSPECTIVE_CAMERA`) is implc's camera
@@ -132,7 +133,7 @@ def _surface(props: Properties, path: Path, overrides: Mapping[str, sympy.Expr],
         notes += (f"implc: note: {props.name}: jsurf 0.4.1 draws this PERSPECTIVE_CAMERA "
                   "beside what it looks at (its window spans 1 to 3 times tan(fov/2) up "
                   "and right of the axis); implc draws the camera's centred view, as "
-                  "jsurf's code means it (README \"SURFER files\")",)
+                  "jsurf's code means it (the docs' \"SURFER files\")",)
     return Surface(path.stem, expr, values, view, str(path), symbolic, notes, limits)
 
 

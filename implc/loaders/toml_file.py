@@ -1,4 +1,5 @@
-"""Surface files in TOML (README "Surface files"), and where each error in one points.
+"""Surface files in TOML (docs/reference/input-language.md "Surface files"), and where each error
+in one points.
 
 A surface file:
 

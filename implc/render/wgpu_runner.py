@@ -23,7 +23,8 @@ from .result import RenderResult, TimedRunner
 
 WORKGROUP = 8  # the workgroup size (8 x 8) in templates/wgsl/program.wgsl.j2
 COLOR_FORMAT = "rgba32float"  # storage-writable in core WebGPU, and exact like GL's f4
-UNIFORM_FLOATS = 20  # struct Uniforms: 80 bytes (README "Drop-in contract (WGSL)")
+UNIFORM_FLOATS = 20  # struct Uniforms: 80 bytes (docs/reference/drop-ins.md "Drop-in contract
+# (WGSL)")
 
 
 def _uniforms(view: View, width: int, height: int,
