@@ -76,7 +76,7 @@ docs: setup
 # when the committed page is stale).
 .PHONY: cli-reference
 cli-reference: setup
-	$(PY) scripts/cli_reference.py > docs/reference/cli.md
+	$(PY) scripts/cli_reference.py docs/reference
 
 # Rewrite every golden shader (every target of implc/targets.py) from the current output;
 # review the diff.
