@@ -117,7 +117,11 @@ bench-baseline: setup
 forms: setup
 	$(PY) scripts/eval_forms.py accuracy --size 512 cross-cap miter steiner roman torus tooth \
 	  sphere kummer cayley clebsch ding-dong whitney-umbrella barth-sextic heart
-	$(PY) scripts/eval_forms.py sweep --size 512 --frames 5 --degrees 2-20 --plot docs/cost-growth.png
+	@mkdir -p results
+	$(PY) scripts/eval_forms.py sweep --size 512 --frames 5 --degrees 2-20 --plot docs/cost-growth.png \
+	  > results/forms-sweep.md
+	$(PY) scripts/docs_section.py forms-sweep results/forms-sweep.md --write docs/RESULTS.md \
+	  --command "make forms"
 
 # What AMD's compiler makes of the degree sweep (issue 49): RADV's ACO statistics on null
 # devices (no GPU needed) of Chmutov T_2..T_20's programs, every method, float and double,

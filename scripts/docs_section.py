@@ -8,7 +8,8 @@ commit and the machine named above them.
     python scripts/docs_section.py bench results/table.md --write docs/RESULTS.md
 
 copies `implc bench`'s table.md (its headings one level down, its own title dropped) under
-a line naming `make bench`, the commit and the machine (`make bench` runs it).
+a line naming `make bench` and the commit (`make bench` runs it); `forms-sweep` does the
+same for the degree sweep's table that `scripts/eval_forms.py sweep` prints (`make forms`).
 """
 
 from __future__ import annotations
@@ -52,14 +53,16 @@ def bench_section(table: str, command: str) -> str:
         lines = lines[1:]
     lines = [("#" + line) if line.startswith("## ") else line for line in lines]
     head = f"Made by `{command}` at commit {commit()}."
-    return head + "\n" + "\n".join(lines).rstrip() + "\n"
+    return head + "\n\n" + "\n".join(lines).strip() + "\n"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("name", choices=["bench"], help="the part of the page to rewrite")
-    ap.add_argument("source", type=Path, help="the measured Markdown (results/table.md)")
+    ap.add_argument("name", choices=["bench", "forms-sweep"],
+                    help="the part of the page to rewrite")
+    ap.add_argument("source", type=Path, help="the measured Markdown (results/table.md, "
+                    "or eval_forms.py sweep's printed table)")
     ap.add_argument("--write", type=Path, required=True, metavar="MARKDOWN")
     ap.add_argument("--command", default="make bench", help="what made the source")
     args = ap.parse_args()

@@ -159,3 +159,27 @@ def test_make_bench_rewrites_its_tables_in_place(tmp_path):
     bare.write_text("# no markers\n", encoding="utf-8")
     proc = subprocess.run([*script, str(bare)], capture_output=True, text=True, timeout=60)
     assert proc.returncode != 0 and "no <!-- bench:begin -->" in proc.stderr, proc.stderr
+
+
+def test_make_forms_rewrites_its_sweep_table_in_place(tmp_path):
+    """`make forms`: the degree sweep's printed table (a real one, at 32^2 and degree 2)
+    goes between the results page's forms-sweep markers under the command and the commit,
+    and nothing outside them moves."""
+    sweep = tmp_path / "forms-sweep.md"
+    proc = subprocess.run([sys.executable, str(ROOT / "scripts" / "eval_forms.py"), "sweep",
+                           "--size", "32", "--frames", "1", "--degrees", "2-2"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    sweep.write_text(proc.stdout, encoding="utf-8")
+    page = tmp_path / "RESULTS.md"
+    before = (ROOT / "docs" / "RESULTS.md").read_text("utf-8")
+    page.write_text(before, encoding="utf-8")
+    run([sys.executable, str(ROOT / "scripts" / "docs_section.py"), "forms-sweep", str(sweep),
+         "--write", str(page), "--command", "make forms"], tmp_path, "docs_section.py")
+    after = page.read_text("utf-8")
+    span = re.compile(r"<!-- forms-sweep:begin -->.*?<!-- forms-sweep:end -->", re.S)
+    assert span.sub("", after) == span.sub("", before)
+    part = span.search(after).group(0)
+    assert "Made by `make forms` at commit " in part
+    assert "\n| chmutov | 2 | " in part and "\n| powers | 2 | " in part
+    assert "| chmutov | 20 |" not in part  # the old run's rows are gone
