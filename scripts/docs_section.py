@@ -8,8 +8,9 @@ commit and the machine named above them.
     python scripts/docs_section.py bench results/table.md --write docs/RESULTS.md
 
 copies `implc bench`'s table.md (its headings one level down, its own title dropped) under
-a line naming `make bench` and the commit (`make bench` runs it); `forms-sweep` does the
-same for the degree sweep's table that `scripts/eval_forms.py sweep` prints (`make forms`).
+a line naming `make bench`, the commit and the machine (`make bench` runs it);
+`forms-sweep` does the same for the degree sweep's table that `scripts/eval_forms.py
+sweep` prints (`make forms`).
 """
 
 from __future__ import annotations
@@ -46,13 +47,29 @@ def commit() -> str:
     return head + ("+" if dirty else "")
 
 
+def machine() -> str:
+    """This machine as a results table names it: its CPU model and core count."""
+    import os
+    import platform
+
+    model = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{model}, {os.cpu_count()} cores"
+
+
 def bench_section(table: str, command: str) -> str:
     """`implc bench`'s table.md as a part of the results page."""
     lines = table.strip().splitlines()
     if lines and lines[0].startswith("# "):
         lines = lines[1:]
     lines = [("#" + line) if line.startswith("## ") else line for line in lines]
-    head = f"Made by `{command}` at commit {commit()}."
+    head = f"Made by `{command}` at commit {commit()} on {machine()}."
     return head + "\n\n" + "\n".join(lines).strip() + "\n"
 
 

@@ -180,6 +180,6 @@ def test_make_forms_rewrites_its_sweep_table_in_place(tmp_path):
     span = re.compile(r"<!-- forms-sweep:begin -->.*?<!-- forms-sweep:end -->", re.S)
     assert span.sub("", after) == span.sub("", before)
     part = span.search(after).group(0)
-    assert "Made by `make forms` at commit " in part
+    assert "Made by `make forms` at commit " in part and " cores." in part  # the machine
     assert "\n| chmutov | 2 | " in part and "\n| powers | 2 | " in part
     assert "| chmutov | 20 |" not in part  # the old run's rows are gone
