@@ -20,7 +20,8 @@ middle sum larger terms), and from degree 7 its Newton reads F from them: `ray_c
 measures that on the view's pixel rays, with the shader's own coefficient program run in
 float32 against float64. Its share of rays moved beyond T_TOL follows exact's share of
 wrong pixels at 512^2 (Chmutov's T_14: 0.28 % both, T_16 3.5 % against 3.2 %), and where
-it is too large, double precision is the remedy (README, "Drop-in contract (GLSL)").
+it is too large, double precision is the remedy (docs/reference/drop-ins.md, "Drop-in
+contract (GLSL)").
 """
 
 from __future__ import annotations

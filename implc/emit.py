@@ -33,14 +33,14 @@ from .targets import TARGETS, flavor_problem, get_target, prefix_problem
 
 EMITS = ("program", "library")
 PARAM_MODES = ("constant", "uniform")
-PARAM_UNIFORM_PREFIX = "u_param_"  # parameter R is the uniform u_param_R (README)
+PARAM_UNIFORM_PREFIX = "u_param_"  # parameter R is the uniform u_param_R
 
 
 @dataclass(frozen=True)
 class ParamUniform:
-    """How one parameter reaches a `--params uniform` shader (README "Parameters as
-    uniforms"): `uniform` is the name the host sets (a GLSL uniform, a WGSL struct field),
-    `ref` how the shader's code reads it."""
+    """How one parameter reaches a `--params uniform` shader (docs/reference/drop-ins.md,
+    "Parameters as uniforms"): `uniform` is the name the host sets (a GLSL uniform, a
+    WGSL struct field), `ref` how the shader's code reads it."""
 
     name: str  # the parameter's name in the equation
     uniform: str

@@ -1,7 +1,7 @@
 """THE table of functions implc supports: name, arity, sympy constructor, numpy semantics.
 
 One row per function. The parser's whitelist (`USER_FUNCTIONS`), the printers' dispatch
-(`BY_SYMPY_NAME`), the CPU evaluator (`numpy`) and the README's list are all read from
+(`BY_SYMPY_NAME`), the CPU evaluator (`numpy`) and the docs' list are all read from
 `FUNCTIONS`; tests/test_targets.py checks every row against every target.
 
 How a row is spelled in a shader language is not a column here: it lives with that

@@ -7,7 +7,7 @@ flavour each, always the library emit with the parameters as uniforms, so that t
 become the host's own controls), the files it loads (a name pattern and a template under
 templates/hosts/<name>/), and what it cannot take. implc/export.py compiles the shaders
 and renders the files; nothing else branches on a host's name. Adding a host is one
-record here, its templates, its test and its README section (docs/guide/hosts.md "Hosts").
+record here, its templates, its test and its section of docs/guide/hosts.md.
 """
 
 from __future__ import annotations

@@ -59,8 +59,8 @@ class Constants:
     # pixel at 1024^2, a ray passing 1e-6 from the z-axis where S >= 0 touches zero
     # (F's minimum 9e-13), counted as a touch that the reference rejects; 1e-9 and 1e-8
     # measured 1-2 and 8-16 false hits at 512^2 next to double lines. Newton stops when
-    # its step is below xtol (times 1 + |u|) or after newton_steps iterations (README
-    # "The exact method")
+    # its step is below xtol (times 1 + |u|) or after newton_steps iterations
+    # (docs/explanation/methods.md, "The exact method")
     touch: float = 1e-13
     xtol: float = 1e-6
     # the same for the critical points (roots of F', F'', ...), which only split the ray

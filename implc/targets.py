@@ -61,8 +61,9 @@ GLSL_FLAVORS = {
 
 @dataclass(frozen=True)
 class ParamLayout:
-    """How the parameters of a `--params uniform` shader reach one emit form (README
-    "Parameters as uniforms"). `{uniform}` is u_param_<name>, `{prefix}` the --prefix."""
+    """How the parameters of a `--params uniform` shader reach one emit form
+    (docs/reference/drop-ins.md, "Parameters as uniforms"). `{uniform}` is u_param_<name>,
+    `{prefix}` the --prefix."""
 
     uniform: str = "{uniform}"  # the name the host sets (a uniform, a struct field)
     ref: str = "{uniform}"  # how the shader's functions read it

@@ -169,8 +169,8 @@ function implcMount(root, DATA, options) {
   // --- WebGPU: the WGSL compute program into a storage texture, blitted to the canvas --
   const gpu = { adapter: null, device: null, context: null, compute: null, blit: null, format: null,
                 size: [0, 0], texture: null, aux: null, uniforms: null, computeGroup: null, blitGroup: null };
-  // The uniform block: 20 floats of camera and clip sphere (README "Drop-in contract
-  // (WGSL)"), the parameters' f32s from float 19 on (`--params uniform`), 16-byte rounded.
+  // The uniform block: 20 floats of camera and clip sphere (docs/reference/drop-ins.md,
+  // "Drop-in contract (WGSL)"), the parameters' f32s from float 19 on (`--params uniform`), 16-byte rounded.
   const uniformFloats = Math.max(20, ...DATA.params.map((p) => p.wgsl_index + 1));
   const uniformBytes = Math.ceil(uniformFloats * 4 / 16) * 16;
   async function initWebGPU() {

@@ -7,7 +7,7 @@
 // Camera: pixel (i, j) looks along normalize(forward + ndc.x*tan(fov/2)*span.x*right
 // + ndc.y*tan(fov/2)*span.y*up), ndc = 2*gl_FragCoord.xy/u_resolution - 1,
 // span = u_resolution/min(u_resolution.x, u_resolution.y): the fov spans the shorter
-// side (see README).
+// side (docs/reference/drop-ins.md, "Camera and pixels").
 uniform vec2 u_resolution;   // framebuffer size in pixels
 uniform vec3 u_eye;          // camera position
 uniform vec3 u_target;       // point the camera looks at

@@ -7,7 +7,7 @@
 // full-screen triangle. SV_Position has its origin at the top-left pixel, rows growing
 // downwards, so pixel (i, j) looks along normalize(forward + ndc.x*tan(fov/2)*span.x*right
 // + ndc.y*tan(fov/2)*span.y*up) with ndc = (2*x/w - 1, 1 - 2*y/h) and
-// span = (w, h)/min(w, h): the fov spans the shorter side (see README).
+// span = (w, h)/min(w, h): the fov spans the shorter side (docs/reference/drop-ins.md, "Camera and pixels").
 // The uniforms are the $Globals constant buffer (set them by name, or move them into
 // your engine's own cbuffer).
 uniform float2 u_resolution;   // render target size in pixels

@@ -17,7 +17,8 @@
 //   aux:   (hit 0/1, t from the eye, march steps, |S| at the hit)
 // Its ray is normalize(forward + ndc.x*tan(fov/2)*span_x*right + ndc.y*tan(fov/2)*span_y*up),
 // ndc = (2(i + 0.5)/width - 1, 1 - 2(j + 0.5)/height), (span_x, span_y) =
-// (width, height)/min(width, height): the fov spans the shorter side (see README).
+// (width, height)/min(width, height): the fov spans the shorter side
+// (docs/reference/drop-ins.md, "Camera and pixels").
 
 // Method constants (implc compile options).
 __constant float IV_ULP = 2.384185791015625e-07f;

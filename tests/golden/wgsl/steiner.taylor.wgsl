@@ -6,10 +6,10 @@
 
 // Compute shader: one invocation per pixel, workgroups of 8 x 8; dispatch
 // (ceil(W/8), ceil(H/8), 1). Pixel (i, j) = global_invocation_id.xy, row j from the top:
-// ndc = (2(i + 0.5)/W - 1, 1 - 2(j + 0.5)/H); u_fov_y spans the shorter side (see README
-// "Camera and pixels").
+// ndc = (2(i + 0.5)/W - 1, 1 - 2(j + 0.5)/H); u_fov_y spans the shorter side
+// (docs/reference/drop-ins.md, "Camera and pixels").
 //
-// Bind group 0 (see README "Drop-in contract (WGSL)"):
+// Bind group 0 (docs/reference/drop-ins.md, "Drop-in contract (WGSL)"):
 //   @binding(0) uniform Uniforms (80 bytes; byte offsets below)
 //   @binding(1) storage texture rgba32float, write: shaded colour, a = 1; size W x H
 //   @binding(2) storage buffer array<vec4<f32>>, W*H entries, index j*W + i:
