@@ -106,6 +106,9 @@ class Target:
     # the shader stages `implc validate --stage` may choose (a language with one kind of
     # file, a compute shader or a kernel, has none to choose)
     stages: tuple[str, ...] = ()
+    # flavour -> glslangValidator's flags that turn its program into Vulkan SPIR-V (GPU
+    # statistics, render/gpu_stats.py); a flavour not here has no path to SPIR-V
+    spirv_flags: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     @property
     def precisions(self) -> tuple[str, ...]:
@@ -153,6 +156,8 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
                       "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
         reserved_prefixes=("gl_",),
         stages=("vert", "frag", "comp", "geom", "tesc", "tese"),
+        # Vulkan's relaxed rules: the plain uniforms become one block at set 0, binding 0
+        spirv_flags={flavor: ("-R", "--aml", "--amb") for flavor in ("330", "450")},
     ),
     Target(
         name="wgsl",
@@ -209,6 +214,7 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         vector_types={"float": ("float", "float2", "float3", "float4")},
         param_layout={"program": ParamLayout(),
                       "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
+        spirv_flags={"default": ("-D", "-e", "main")},  # glslang's HLSL front end
     ),
 )}
 

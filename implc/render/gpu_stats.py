@@ -28,10 +28,10 @@ from pathlib import Path
 from ..emit import CompiledShader, render_template
 from ..errors import OptionError, ToolError
 from ..options import GPU_FAMILIES
+from ..targets import TARGETS, get_target
 from .hlsl_runner import _run
 
 ICD_DIRS = ("/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d")
-GLSL_FLAVORS = ("330", "450")  # the desktop flavours (ES and Shadertoy have no Vulkan form)
 CLIENT = Path(__file__).with_name("vulkan_stats.py")  # imports nothing of implc
 TIMEOUT = 600  # seconds for one family's pipelines (a degree-20 program compiles in ~1 s)
 
@@ -73,15 +73,18 @@ NAMES = {"VGPRs": "vgprs", "SGPRs": "sgprs", "Spilled VGPRs": "spilled_vgprs",
 
 
 def spirv_problem(shader: CompiledShader) -> str | None:
-    """Why this shader has no path to SPIR-V here (None: it has one)."""
+    """Why this shader has no path to SPIR-V here (None: it has one): its target's record
+    names the flavours glslang turns into Vulkan SPIR-V (Target.spirv_flags)."""
     if shader.emit != "program":
         return "only a program (not a library) is a whole pipeline stage"
-    if shader.target == "hlsl" or (shader.target == "glsl" and shader.flavor in GLSL_FLAVORS):
+    flags = get_target(shader.target).spirv_flags
+    if shader.flavor in flags:
         return None
-    if shader.target == "glsl":
-        return (f"the GLSL flavour {shader.flavor} has no Vulkan form here (use --flavor "
-                f"{' or '.join(GLSL_FLAVORS)})")
-    return f"{shader.target} has no path to SPIR-V here (targets hlsl and glsl do)"
+    if flags:
+        return (f"the {shader.target} flavour {shader.flavor} has no Vulkan form here (use "
+                f"--flavor {' or '.join(flags)})")
+    able = [t.name for t in TARGETS.values() if t.spirv_flags]
+    return f"{shader.target} has no path to SPIR-V here (targets {' and '.join(able)} do)"
 
 
 def radv_problem() -> str | None:
@@ -102,13 +105,12 @@ def radv_manifest() -> str | None:
     return None
 
 
-def _glslang(text: str, stage: str, hlsl: bool) -> bytes:
-    """SPIR-V of one stage by glslangValidator (HLSL: entry point main)."""
+def _glslang(text: str, stage: str, flags: Sequence[str]) -> bytes:
+    """SPIR-V of one stage by glslangValidator with the target's `flags`."""
     tool = "glslangValidator"
     with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
         source, spirv = os.path.join(tmp, f"shader.{stage}"), os.path.join(tmp, "shader.spv")
         Path(source).write_text(text, encoding="utf-8")
-        flags = ["-D", "-e", "main"] if hlsl else ["-R", "--aml", "--amb"]
         _run([tool, *flags, "-V", "-S", stage, "-o", spirv, source])
         return Path(spirv).read_bytes()
 
@@ -121,14 +123,15 @@ def _check_spirv(shader: CompiledShader) -> None:
 def fragment_spirv(shader: CompiledShader) -> bytes:
     """The program's fragment stage as SPIR-V (OptionError where it has no path there)."""
     _check_spirv(shader)
-    return _glslang(shader.text, "frag", hlsl=shader.target == "hlsl")
+    return _glslang(shader.text, "frag",
+                    get_target(shader.target).spirv_flags[shader.flavor])
 
 
 @functools.cache
 def vertex_spirv() -> bytes:
     """The full-screen triangle (templates/glsl/fullscreen.vert.j2) as SPIR-V."""
     return _glslang(render_template("glsl/fullscreen.vert.j2", version="450 core"), "vert",
-                    hlsl=False)
+                    get_target("glsl").spirv_flags["450"])
 
 
 def check_family(family: str) -> str:
