@@ -49,6 +49,18 @@ class ParamUniform:
     offset: int | None = None  # byte offset in the program's uniform struct, if it has one
 
 
+# A parameter's control (the viewer's slider, a host's input) spans its value
+# +- max(|value|, PARAM_MIN_HALF_WIDTH)
+PARAM_MIN_HALF_WIDTH = 0.5
+
+
+def param_range(value: float) -> tuple[float, float]:
+    """The (low, high) of a parameter's control, to 6 significant digits (0.35 - 0.5 is
+    -0.15, not -0.15000000000000002, in a host's file)."""
+    half = max(abs(value), PARAM_MIN_HALF_WIDTH)
+    return float(f"{value - half:.6g}"), float(f"{value + half:.6g}")
+
+
 def param_uniforms(surface: Surface, target: str = "glsl", emit_form: str = "program",
                    prefix: str = "") -> list[ParamUniform]:
     """The parameters of `surface` as uniforms of a `--params uniform` shader, sorted by

@@ -12,16 +12,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .emit import CompiledShader, compile_shader, render_template
+from .emit import CompiledShader, compile_shader, param_range, render_template
 from .errors import OptionError
 from .hosts import Host
 from .methods import Constants, get_method
 from .scene import SHADING
 from .surface import Surface
 from .version import __version__
-
-# A control spans value +- max(|value|, CONTROL_MIN_HALF_WIDTH), as the viewer's sliders do
-CONTROL_MIN_HALF_WIDTH = 0.5
 
 
 @dataclass(frozen=True)
@@ -55,12 +52,12 @@ def export_files(surface: Surface, host: Host, method: str,
     if precision not in host.precisions:
         raise OptionError(f"--precision {precision}: the {host.name} host cannot take it "
                           f"({host.precision_reason})")
-    if get_method(method).name in host.methods_refused:
+    meth = get_method(method)
+    if meth.name in host.methods_refused:
         raise OptionError(f"-m {method}: the {host.name} host cannot take it "
-                          f"({host.methods_refused[get_method(method).name]})")
+                          f"({host.methods_refused[meth.name]})")
     name = stem(surface.name, host.stem_case)
     prefix = host.prefix.format(stem=stem(surface.name, "snake")) if prefix is None else prefix
-    meth = get_method(method)
     constants = constants or meth.defaults
     shaders: dict[str, CompiledShader] = {
         s.key: compile_shader(surface, s.target, method, constants, s.flavor, "library",
@@ -69,9 +66,7 @@ def export_files(surface: Surface, host: Host, method: str,
                               declare_params=s.declare_params)
         for s in host.shaders}
     first = next(iter(shaders.values()))
-    controls = [Control(u.name, u.uniform, u.value,
-                        _round(u.value - max(abs(u.value), CONTROL_MIN_HALF_WIDTH)),
-                        _round(u.value + max(abs(u.value), CONTROL_MIN_HALF_WIDTH)))
+    controls = [Control(u.name, u.uniform, u.value, *param_range(u.value))
                 for u in first.uniforms]
     context = {
         "host": host, "stem": name, "prefix": prefix, "method": meth.name,
@@ -83,7 +78,3 @@ def export_files(surface: Surface, host: Host, method: str,
     return {pattern.format(stem=name): render_template(template, **context)
             for pattern, template in host.files.items()}
 
-
-def _round(x: float) -> float:
-    """A control's end to 6 significant digits (0.35 - 0.5 is -0.15000000000000002)."""
-    return float(f"{x:.6g}")

@@ -13,14 +13,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from .emit import emit, param_uniforms, render_template
+from .emit import emit, param_range, param_uniforms, render_template
 from .marcher import default_method
 from .methods import Constants, get_method
 from .surface import Surface
 
-# A slider spans value +- max(|value|, SLIDER_MIN_HALF_WIDTH) in SLIDER_TICKS steps.
-SLIDER_MIN_HALF_WIDTH = 0.5
-SLIDER_TICKS = 1000
+SLIDER_TICKS = 1000  # a slider's steps over its range (emit.param_range)
 
 
 @dataclass(frozen=True)
@@ -44,9 +42,8 @@ def sliders(surface: Surface) -> list[Slider]:
     result = []
     wgsl = {u.name: u for u in param_uniforms(surface, "wgsl")}
     for u in param_uniforms(surface, "glsl"):
-        half = max(abs(u.value), SLIDER_MIN_HALF_WIDTH)
-        result.append(Slider(u.name, u.uniform, wgsl[u.name].offset, u.value, u.value - half,
-                             u.value + half))
+        result.append(Slider(u.name, u.uniform, wgsl[u.name].offset, u.value,
+                             *param_range(u.value)))
     return result
 
 
