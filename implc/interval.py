@@ -94,7 +94,7 @@ def range_program(*exprs: sympy.Expr) -> RangeProgram:
     """The enclosures of `exprs` over a ray segment, jointly (a subexpression they share
     is enclosed once), from their trees (see the module's doc). Cached: the default
     method's check, the lowering and `show` ask for the same program."""
-    builder = _Builder()
+    builder = _bounded(exprs[0]).copy()
     bounds = [builder.bound(exprs[0])]
     poles = list(builder.poles)  # F's own (F''s, of sqrt at 0 say, are not F's)
     bounds += [builder.bound(e) for e in exprs[1:]]
@@ -106,6 +106,15 @@ def range_program(*exprs: sympy.Expr) -> RangeProgram:
     if dead is not sympy.false:
         bounds = [tuple(Piecewise((1, dead), (v, True)) for v in pair) for pair in bounds]
     return RangeProgram(tuple(builder.lets), tuple(bounds))
+
+
+@lru_cache(maxsize=16)
+def _bounded(expr: sympy.Expr) -> _Builder:
+    """A builder that has enclosed `expr`: F's program alone (the default method's check)
+    and F's with F''s (the march) start from it, so F's tree is enclosed once."""
+    builder = _Builder()
+    builder.bound(expr)
+    return builder
 
 
 def unbounded(lo, hi):
@@ -135,6 +144,13 @@ class _Builder:
         self.poles: list[sympy.Basic] = []  # where a bound was unbounded (+-BIG)
         self.memo: dict[sympy.Basic, tuple[sympy.Expr, sympy.Expr]] = {}
         self.named: dict[sympy.Basic, sympy.Symbol] = {}  # a value let twice: one name
+
+    def copy(self) -> _Builder:
+        """An independent builder in this one's state (the cached one stays as it is)."""
+        twin = _Builder()
+        twin.lets, twin.dead, twin.poles = list(self.lets), list(self.dead), list(self.poles)
+        twin.memo, twin.named = dict(self.memo), dict(self.named)
+        return twin
 
     # --- lets and widening -------------------------------------------------------------
     def let(self, value: sympy.Basic, stem: str) -> sympy.Expr:
@@ -301,10 +317,11 @@ def range_function(name: str, program: RangeProgram, printer, prefix: str,
     """`F_range(ray, a, b)` (or `DF_range`, F''s): the enclosure over [a, b] as (lo, hi),
     printed."""
     names = {ULP: sym(prefix.upper() + "IV_ULP"), TINY: sym(prefix.upper() + "IV_TINY")}
-    lets = tuple(("real", name.name, printer.doprint(value.xreplace(names)))
-                 for name, value in program.assignments)
-    outputs = tuple(printer.doprint(v.xreplace(names)) for pair in program.bounds
-                    for v in pair)
+    with printer.sums_as_held():  # machine-made bounds: printed fast, not sorted to read
+        lets = tuple(("real", name.name, printer.doprint(value.xreplace(names)))
+                     for name, value in program.assignments)
+        outputs = tuple(printer.doprint(v.xreplace(names)) for pair in program.bounds
+                        for v in pair)
     params = (("Ray", "ray"), ("real", "a"), ("real", "b")) + carried
     what = "F's and F''s enclosures (lo, hi, lo', hi')" if len(outputs) == 4 else \
         "F's enclosure (lo, hi)"

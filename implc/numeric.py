@@ -47,8 +47,7 @@ def _eval(node, env, cache, real=np.float64):
     elif node.is_Number or node.is_NumberSymbol:
         value = real(float(node))
     elif node.is_Add:
-        value = sum((_eval(a, env, cache, real) for a in node.args[1:]),
-                    _eval(node.args[0], env, cache, real))
+        value = _sum([_eval(a, env, cache, real) for a in node.args])
     elif node.is_Mul:
         value = _eval(node.args[0], env, cache, real)
         for a in node.args[1:]:
@@ -78,6 +77,11 @@ def _eval(node, env, cache, real=np.float64):
         row = BY_SYMPY_NAME.get(name)
         if row is None:
             raise NotImplementedError(f"no numeric meaning for {name}")
+        if isinstance(node, sympy.exp) and node.args[0].is_Add:
+            value = _exp_of_sum([_eval(a, env, cache, real) for a in node.args[0].args])
+            if value is not None:
+                cache[node] = value
+                return value
         args = [_eval(a, env, cache, real) for a in node.args]
         if row.arity == 2 and len(args) > 2:  # Min/Max with more arguments
             value = args[0]
@@ -86,6 +90,44 @@ def _eval(node, env, cache, real=np.float64):
         else:
             value = row.numpy(*args)
     cache[node] = value
+    return value
+
+
+def _sum(terms: list) -> np.ndarray:
+    """terms[0] + terms[1] + ..., left to right (as the plain sum rounds), accumulated in
+    place in one array of the broadcast shape rather than a new array per term."""
+    shape = np.broadcast_shapes(*(np.shape(t) for t in terms))
+    if not shape:
+        return sum(terms[1:], terms[0])
+    total = np.array(np.broadcast_to(terms[0], shape), dtype=np.result_type(*terms))
+    for term in terms[1:]:
+        total += term
+    return total
+
+
+def _exp_of_sum(terms: list) -> np.ndarray | None:
+    """exp(t0 + t1 + ...) as exp(t0) exp(t1) ... where every term varies along fewer
+    axes than their sum (framing's tensor grid: a gaussian's x part is a line, the sum a
+    volume), so exp runs on the lines, not at every grid point; None where that does not
+    hold, or where a term leaves [-700, 700] (a factor could overflow where the whole
+    does not)."""
+    shape = np.broadcast_shapes(*(np.shape(t) for t in terms))
+    size = int(np.prod(shape)) if shape else 1
+    if size < 2 or any(np.size(t) >= size for t in terms):
+        return None
+    if any(not np.all(np.abs(t) <= 700.0) for t in terms):  # (NaN fails this too)
+        return None
+    factors = [np.exp(t) for t in terms]
+    return _product_small_first(factors)
+
+
+def _product_small_first(factors: list) -> np.ndarray:
+    """The product, smallest factors first, so only the last multiplications reach the
+    full broadcast shape."""
+    factors = sorted(factors, key=np.size)
+    value = factors[0]
+    for f in factors[1:]:
+        value = value * f
     return value
 
 

@@ -11,6 +11,9 @@ and an implc error (not a driver error) for anything unsupported.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 import sympy
 from sympy.printing.precedence import PRECEDENCE, precedence
 
@@ -45,6 +48,19 @@ class ShaderPrinterMixin:
                              f"{', '.join(literal_suffix)}")
         self.precision = precision
         self.float_suffix = literal_suffix[precision]
+
+    @contextmanager
+    def sums_as_held(self) -> Iterator[None]:
+        """Within: print a sum's terms in the order sympy holds them (its canonical order,
+        as deterministic as the sorted one) rather than sorted for reading. Sorting is
+        most of the time of printing a long machine-made program (the interval method's
+        enclosures: 0.8 s of CPU against 0.33 s for sixty gaussians' 4,358 lets)."""
+        saved = self._settings.get("order")
+        self._settings["order"] = "none"
+        try:
+            yield
+        finally:
+            self._settings["order"] = saved
 
     def float_literal(self, value: float) -> str:
         """Shortest decimal that round-trips the float64 value, typed for the target."""
