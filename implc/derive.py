@@ -41,9 +41,15 @@ def estimate_derived_size(expr: sympy.Expr) -> int:
     product and chain rules, with no credit for sharing; nested compositions grow like
     depth^3 here exactly as they do in sympy (`sin(sin(...(xyz)))`, 40 deep: ~640,000).
     """
-    point = set(POINT)
-    s, d1, d2 = fold_tree(expr, lambda node, parts: _node_estimate(node, parts, point))
+    s, d1, d2 = _estimates(expr)
     return min(_CAP, s + 4 * d1 + 7 * d2)
+
+
+def _estimates(expr: sympy.Expr) -> tuple[int, int, int]:
+    """(s, d1, d2) of S: its size, a first and a second partial derivative's (no credit
+    for sharing)."""
+    point = set(POINT)
+    return fold_tree(expr, lambda node, parts: _node_estimate(node, parts, point))
 
 
 def fold_tree(expr: sympy.Expr,
@@ -94,13 +100,29 @@ def check_derived_size(expr: sympy.Expr, max_derived: int = DEFAULT_MAX_DERIVED)
     for minutes (or exhaust memory or Python's recursion limit inside sympy) stops at once.
     """
     limit = max_derived
-    size = estimate_derived_size(expr)
-    if size > limit:
+    s, d1, d2 = _estimates(expr)
+    size = min(_CAP, s + 4 * d1 + 7 * d2)  # estimate_derived_size
+    weighed = 0 if expr.is_polynomial(*POINT) else min(_CAP, FUNCTION_WEIGHT * d1)
+    if max(size, weighed) > limit:
+        how = f" (a surface with functions: {FUNCTION_WEIGHT} a node of a partial " \
+            "derivative)" if weighed > size else ""
         raise LimitError(
-            f"too complex: derivatives would have about {_approx(size)} nodes, exceeding the "
-            f"limit of {limit} (--max-derived)"
+            f"too complex: derivatives would have about {_approx(max(size, weighed))} "
+            f"nodes{how}, exceeding the limit of {limit} (--max-derived)"
         )
-    return size
+    return max(size, weighed)
+
+
+# A surface with functions (exp, sin, sqrt, 1/u, min, ...) is also bounded by the size of
+# a first partial derivative (d1 of `_node_estimate`) times this: its compile costs
+# 0.45-0.9 ms of CPU per node of d1 (sums of 20-80 gaussians, sines and inverse squares,
+# min of 5-20 distances, 10-40 nested sines; scripts/compile_times.py --families), since
+# every function node is differentiated, enclosed (the interval method's F and F') and
+# printed through sympy's slower paths, where a polynomial (differentiated as a Poly, its
+# ray coefficients by Horner's scheme) costs 5.5-8 us per node of the estimate. Either
+# way what passes 500,000 compiles in about 3 s; the corpus's largest with functions
+# (Chain, d1 1,342) weighs 215,000.
+FUNCTION_WEIGHT = 160
 
 
 def _approx(n: int) -> str:

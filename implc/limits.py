@@ -30,6 +30,8 @@ class Limits:
     # exactly while parsing (literals, folded constants such as 2^100 or 9^9^9); a root
     # of rational constants, r^(p/q), needs q x digits(r) <= 10 x this.
     max_constant_digits: int = 300
-    # Estimated size (tree nodes) of the derivatives a marcher needs, before CSE; checked
-    # by implc.derive before differentiating (derivation and CSE time grow with it).
+    # Estimated size (tree nodes) of the derivatives a marcher needs, before CSE, and for a
+    # surface with functions also 160 per node of a partial derivative
+    # (derive.FUNCTION_WEIGHT); checked by implc.derive before differentiating (derivation
+    # and CSE time grow with it).
     max_derived: int = 500_000

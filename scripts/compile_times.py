@@ -4,6 +4,12 @@ machine. Prints the distribution over the rows that compile and the slowest ten
 (docs/RESULTS.md, "Compile time on the corpus"); `make compile-times` runs it.
 
     python scripts/compile_times.py [TSV] [-j 2] [--rows 1-20,51] [-o TABLE.md]
+    python scripts/compile_times.py --families       growing inputs with functions
+
+`--families` compiles members of growing size of five shapes with functions (sums of
+gaussians, of sines, of inverse squares, a min of distances, nested sines) the same way,
+beside the bound's estimate (derive.estimate_derived_size, and weighed as
+`--max-derived` counts it): what calibrates derive.FUNCTION_WEIGHT.
 
 Each time is the child's wall time (what a user waits) and its CPU time (user + system,
 from wait4: what the machine's load does not inflate). Exit 1 is a refusal (the row's
@@ -20,7 +26,7 @@ import sys
 import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 
@@ -59,6 +65,59 @@ def time_row(row, workdir: Path) -> Timing:
     message = next((line for line in stderr.splitlines() if "error" in line), "")
     return Timing(row.number, row.name, row.degree, child.returncode, wall,
                   usage.ru_utime + usage.ru_stime, message.strip())
+
+
+# name -> the member of size n (docs/reference/errors.md quotes what they measure)
+FAMILIES = {
+    "gaussians": lambda n: "+".join(f"exp(-((x-{i / 10})^2+(y-{i / 7})^2+z^2))"
+                                    for i in range(n)) + "-0.5",
+    "sines": lambda n: "+".join(f"sin({i + 1}*x+{i / 3})*cos({i % 5 + 1}*y)"
+                                for i in range(n)) + "+z",
+    "inverse-squares": lambda n: "+".join(f"1/((x-{i / 10})^2+(y-{i / 7})^2+z^2+0.1)"
+                                          for i in range(n)) + "-3",
+    "min-of-distances": lambda n: "min(" + ",".join(f"sqrt((x-{i / 9})^2+(y-{i / 11})^2+z^2)-0.3"
+                                                    for i in range(n)) + ")",
+    "nested-sines": lambda n: "sin(" * n + "x*y*z" + ")" * n + "+x^2+y^2+z^2-1",
+}
+FAMILY_SIZES = {"gaussians": (20, 40, 60), "sines": (20, 40, 80),
+                "inverse-squares": (20, 40, 80), "min-of-distances": (5, 10, 20),
+                "nested-sines": (10, 20, 34, 40)}
+
+
+@dataclass
+class Member:
+    """A family's member, shaped as a corpus row for `time_row`."""
+
+    number: int
+    name: str
+    equation: str
+    degree: None = None
+    params: dict = field(default_factory=dict)
+
+
+def families(workdir: Path) -> str:
+    """Each family member's estimate, weighed estimate, outcome and times."""
+    from implc.derive import check_derived_size, estimate_derived_size
+    from implc.errors import LimitError
+    from implc.loaders import load_surface
+
+    lines = ["| family | n | estimate | weighed | outcome | wall s | CPU s |",
+             "|---|---:|---:|---:|---|---:|---:|"]
+    for name, make in FAMILIES.items():
+        for n in FAMILY_SIZES[name]:
+            member = Member(n, name, make(n))
+            expr = load_surface(equation=member.equation).expr
+            estimate = estimate_derived_size(expr)
+            try:
+                weighed = check_derived_size(expr, 10**15)
+            except LimitError:  # past even that bound
+                weighed = -1
+            t = time_row(member, workdir)
+            outcome = {0: "compiled", 1: "refused"}.get(t.code, f"exit {t.code}")
+            lines.append(f"| {name} | {n} | {estimate:,} | {weighed:,} | "
+                         f"{outcome} | {t.wall:.2f} | {t.cpu:.2f} |")
+            print(lines[-1], file=sys.stderr, flush=True)
+    return "\n".join(lines) + "\n"
 
 
 def quantile(values: list[float], q: float) -> float:
@@ -102,7 +161,16 @@ def main() -> None:
     ap.add_argument("-j", type=int, default=2, help="rows at a time (default 2)")
     ap.add_argument("--rows", help="only these rows, e.g. 1-20,51")
     ap.add_argument("-o", type=Path, help="also write the table to this Markdown file")
+    ap.add_argument("--families", action="store_true",
+                    help="time growing inputs with functions instead of the corpus")
     args = ap.parse_args()
+    if args.families:
+        with tempfile.TemporaryDirectory() as tmp:
+            text = families(Path(tmp))
+        print(text, end="")
+        if args.o:
+            args.o.write_text(text)
+        return
     tsv = args.tsv or default_tsv()
     if tsv is None:
         sys.exit("compile_times: no corpus TSV found (../shared/corpus/)")

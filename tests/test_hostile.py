@@ -341,6 +341,8 @@ def test_max_derived_is_configurable(tmp_path):
     "max(" * 60 + "x" + "".join(f",y+{i}z)" for i in range(60)),
     "sqrt(" * 120 + "x^2+1" + "+1)" * 120,
     "*".join("atan(" * 8 + f"x*y*z+{i}" + ")" * 8 for i in range(12)),
+    # sixty gaussians, 216,000 nodes: 3.7-4.7 s to compile (issue 44, point 9), weighed x5
+    "+".join(f"exp(-((x-{i / 10})^2+(y-{i / 7})^2+z^2))" for i in range(60)) + "-0.5",
 ])
 def test_over_large_valid_inputs_stop_before_differentiating(equation, monkeypatch):
     """Shapes that pass the parser but would run for minutes, recurse past Python's
@@ -357,6 +359,29 @@ def test_over_large_valid_inputs_stop_before_differentiating(equation, monkeypat
     with pytest.raises(LimitError, match=r"\(--max-derived\)$"):
         emit(surface, "glsl", "hessian")
     assert derived == []
+
+
+def test_a_surface_with_functions_weighs_more():
+    """A surface with functions is also bounded by FUNCTION_WEIGHT per node of a partial
+    derivative (its compile costs 0.45-0.9 ms of CPU per such node), so that what passes
+    compiles in about 3 s; a polynomial's estimate is taken as it is. Twenty gaussians
+    pass, sixty (3.7-4.7 s to compile, issue 44's point 9) are refused at once."""
+    from implc.derive import FUNCTION_WEIGHT, check_derived_size, estimate_derived_size
+    from implc.errors import LimitError
+    from implc.loaders import load_surface
+
+    def gaussians(n: int) -> sympy.Expr:
+        return load_surface(equation="+".join(f"exp(-((x-{i / 10})^2+(y-{i / 7})^2+z^2))"
+                                              for i in range(n)) + "-0.5").expr
+
+    assert FUNCTION_WEIGHT == 160
+    twenty = gaussians(20)
+    assert 500_000 > check_derived_size(twenty) > 5 * estimate_derived_size(twenty)
+    with pytest.raises(LimitError, match=r"about 1,200,000 nodes \(a surface with "
+                                         r"functions: 160 a node of a partial derivative\)"):
+        check_derived_size(gaussians(60))
+    knot = load_surface(equation="(x^2+y^2+z^2)^3 - 4x^2 y^2 z + x y - 1").expr
+    assert check_derived_size(knot) == estimate_derived_size(knot)
 
 
 def test_every_limit_has_its_option():

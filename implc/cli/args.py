@@ -56,7 +56,8 @@ LIMIT_FLAGS = {
     "--max-terms": "most monomials after expansion",
     "--max-literal-exponent": "number literals must lie within 1e-N .. 1e+N",
     "--max-constant-digits": "most digits of an exactly computed constant",
-    "--max-derived": "largest estimated size of the derivatives before CSE, in nodes",
+    "--max-derived": "largest estimated size of the derivatives before CSE, in nodes (a "
+                     "surface with functions: also 160 per node of a partial derivative)",
 }
 
 # [view] key -> its option (`target` is --look-at: -t/--target is the shader language)
