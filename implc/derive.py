@@ -353,12 +353,14 @@ def expanded_terms(expr: sympy.Expr) -> dict[tuple[int, int, int], sympy.Expr]:
     monomials: 9.6 s there, a fraction of a second here). A sub-expression free of x, y, z
     (a number, sqrt(5), a parameter kept as a symbol) is a coefficient."""
     point = set(POINT)
+    one = 1
 
     def combine(node: sympy.Basic, parts: list) -> dict:
-        if not node.free_symbols & point:
-            return {(0, 0, 0): node}
+        if not node.free_symbols & point:  # rationals as Python's int and Fraction (their
+            # arithmetic is 5-50x sympy's), anything else as sympy keeps it
+            return {(0, 0, 0): _python_rational(node) if node.is_Rational else node}
         if node.is_Symbol:
-            return {tuple(int(node == v) for v in POINT): sympy.S.One}
+            return {tuple(int(node == v) for v in POINT): one}
         if node.is_Add:
             return _poly_sum(parts)
         if node.is_Mul:
@@ -367,17 +369,22 @@ def expanded_terms(expr: sympy.Expr) -> dict[tuple[int, int, int], sympy.Expr]:
                 result = _poly_product(result, part)
             return result
         if node.is_Pow and node.exp.is_Integer and node.exp >= 0:
-            return _power(parts[0], int(node.exp), _poly_product, {(0, 0, 0): sympy.S.One})
+            return _power(parts[0], int(node.exp), _poly_product, {(0, 0, 0): one})
         raise ValueError(f"not a polynomial node: {node}")
 
-    return fold_tree(expr, combine)
+    return {key: sympy.Rational(c.numerator, c.denominator) if isinstance(c, int | Fraction)
+            else c for key, c in fold_tree(expr, combine).items()}
+
+
+def _python_rational(r: sympy.Rational) -> int | Fraction:
+    return int(r.p) if r.q == 1 else Fraction(int(r.p), int(r.q))
 
 
 def _poly_sum(parts: list[dict]) -> dict:
     result: dict = {}
     for part in parts:
         for key, c in part.items():
-            result[key] = result.get(key, sympy.S.Zero) + c
+            result[key] = result[key] + c if key in result else c
     return {k: c for k, c in result.items() if c != 0}
 
 
@@ -386,7 +393,7 @@ def _poly_product(a: dict, b: dict) -> dict:
     for (i, j, k), c in a.items():
         for (p, q, r), d in b.items():
             key = (i + p, j + q, k + r)
-            result[key] = result.get(key, sympy.S.Zero) + c * d
+            result[key] = result[key] + c * d if key in result else c * d
     return {k: c for k, c in result.items() if c != 0}
 
 

@@ -135,14 +135,24 @@ _RELATIONS = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.great
               "==": np.equal, "!=": np.not_equal}
 
 
+def _power_by_halves(base, n: int):
+    """base^n as the shaders' power chains compute it (optimize._power_chain):
+    b^n = b^(n // 2) b^(n - n // 2), each power once; about log2 n products, not n - 1."""
+    have = {1: base}
+
+    def build(k: int):
+        if k not in have:
+            have[k] = build(k // 2) * build(k - k // 2)
+        return have[k]
+
+    return np.ones_like(base) if n == 0 else build(n)
+
+
 def _pow(base, exp, env, cache, real=np.float64):
     if exp.is_Integer:
         n = int(exp)
-        result = np.ones_like(base) if n >= 0 else None
         if n >= 0:
-            for _ in range(n):
-                result = result * base
-            return result
+            return _power_by_halves(base, n)
         inv = 1.0 / base
         result = np.ones_like(inv)
         for _ in range(-n):

@@ -7,7 +7,8 @@ machine. Prints the distribution over the rows that compile and the slowest ten
     python scripts/compile_times.py --families       growing inputs with functions
 
 `--families` compiles members of growing size of five shapes with functions (sums of
-gaussians, of sines, of inverse squares, a min of distances, nested sines) the same way,
+gaussians, of sines, of inverse squares, a min of distances, nested sines) and two
+polynomial ones (sums of twelfth powers of planes, products of shells) the same way,
 beside the bound's estimate (derive.estimate_derived_size, and weighed as
 `--max-derived` counts it): what calibrates derive.FUNCTION_WEIGHT.
 
@@ -78,10 +79,15 @@ FAMILIES = {
     "min-of-distances": lambda n: "min(" + ",".join(f"sqrt((x-{i / 9})^2+(y-{i / 11})^2+z^2)-0.3"
                                                     for i in range(n)) + ")",
     "nested-sines": lambda n: "sin(" * n + "x*y*z" + ")" * n + "+x^2+y^2+z^2-1",
+    # polynomials: powers of planes (expanded for Horner's scheme), nested shells
+    "powers-of-planes": lambda n: "+".join(f"({i % 5 - 2}*x+{i % 3 - 1}*y+{i % 7 - 3}*z+1)^12"
+                                           for i in range(n)) + "-1",
+    "shells": lambda n: "*".join(f"(x^2+y^2+z^2-{i}/{n})" for i in range(1, n + 1)) + "-0.001",
 }
 FAMILY_SIZES = {"gaussians": (20, 40, 60), "sines": (20, 40, 80),
                 "inverse-squares": (20, 40, 80), "min-of-distances": (5, 10, 20),
-                "nested-sines": (10, 20, 34, 40)}
+                "nested-sines": (10, 20, 34, 40), "powers-of-planes": (20, 40, 60),
+                "shells": (5, 10, 20)}
 
 
 @dataclass
@@ -96,7 +102,8 @@ class Member:
 
 
 def families(workdir: Path) -> str:
-    """Each family member's estimate, weighed estimate, outcome and times."""
+    """Each family member's estimate, weighed estimate (as --max-derived counts it),
+    outcome and times."""
     from implc.derive import check_derived_size, estimate_derived_size
     from implc.errors import LimitError
     from implc.loaders import load_surface
