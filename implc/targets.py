@@ -279,6 +279,47 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
 )}
 
 
+@dataclass(frozen=True)
+class Probe:
+    """A driver the float32 probe (`implc probe`, render/eft_probe.py) runs on: a backend
+    (a render backend, or a browser's), the language and flavour it compiles, the
+    function that runs the program ((text, cases as (op, a, b, n) rows) -> pairs) and the
+    one that names the driver and its version."""
+
+    backend: str
+    target: str
+    flavor: str | None
+    runner: str  # "module:function"
+    driver: str  # "module:function" -> the driver's name and version
+
+    @property
+    def title(self) -> str:
+        tgt = get_target(self.target)
+        flavor = f" {self.flavor}" if self.flavor else ""
+        return f"{self.backend}: {self.target}{flavor} (guard: {tgt.rules(self.flavor).guard})"
+
+
+# every float32 driver implc runs; webgl2 also stands for Shadertoy (WebGL2 in a page)
+PROBES = (
+    Probe("gl", "glsl", "330", "implc.render.eft_probe:run_gl",
+          "implc.render.eft_probe:gl_driver"),
+    Probe("gl", "glsl", "450", "implc.render.eft_probe:run_gl",
+          "implc.render.eft_probe:gl_driver"),
+    Probe("wgpu", "wgsl", None, "implc.render.eft_probe:run_wgpu",
+          "implc.render.eft_probe:wgpu_driver"),
+    Probe("cl", "opencl", None, "implc.render.eft_probe:run_cl",
+          "implc.render.eft_probe:cl_driver"),
+    Probe("hlsl-spirv", "hlsl", None, "implc.render.eft_probe:run_hlsl",
+          "implc.render.eft_probe:gl_driver"),
+    Probe("webgl2", "glsl", "es300", "implc.render.browser_probe:run_webgl2",
+          "implc.render.browser_probe:browser_driver"),
+    Probe("webgpu", "wgsl", None, "implc.render.browser_probe:run_webgpu",
+          "implc.render.browser_probe:browser_driver"),
+)
+PROBE_BACKENDS = tuple(dict.fromkeys(p.backend for p in PROBES))
+
+
+
 def get_target(name: str) -> Target:
     try:
         return TARGETS[name]

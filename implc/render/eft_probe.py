@@ -24,7 +24,7 @@ import numpy as np
 from ..emit import eft_probe_text, render_template
 from ..errors import ToolError
 from ..interrupts import signals_held
-from ..targets import get_target, resolve
+from ..targets import PROBES, Probe, get_target, resolve
 
 # the probe's cases by number (templates/eft_probe.j2)
 OPS = {"two_sum": 0, "fast_two_sum": 1, "two_prod_split": 2, "two_prod_fma": 3, "sum2": 4,
@@ -87,13 +87,16 @@ CASES = (
 
 
 def _num(x: float) -> str:
-    """2^-30 for a power of two, else float32's shortest digits."""
+    """2^-30 for a power of two, 1+2^-12 for one more than one, else float32's shortest
+    digits."""
     if x == 0:
         return "0"
     mantissa, exponent = math.frexp(abs(x))
     if mantissa == 0.5 and exponent != 1:
         return ("-" if x < 0 else "") + f"2^{exponent - 1}"
-    return repr(float(F32(x))) if float(F32(x)) == x else f"{float(F32(x)):.9g}"
+    if x > 1 and _num(x - 1).startswith("2^"):
+        return f"1+{_num(x - 1)}"
+    return str(F32(x))
 
 
 @dataclass(frozen=True)
@@ -119,42 +122,7 @@ class Outcome:
         verdict = "ok" if self.ok else "LOST"
         if not self.relied_on:
             verdict += " (fma rounds once)" if self.ok else " (fma rounds twice; two_prod splits)"
-        return f"{self.case.label:<36} {what:<42} {verdict}"
-
-
-@dataclass(frozen=True)
-class Probe:
-    """A driver the probe runs on: a backend, the language and flavour it compiles, and
-    the function that runs the program: (text, cases as (op, a, b, n) rows) -> pairs."""
-
-    backend: str
-    target: str
-    flavor: str | None
-    runner: str  # "module:function"
-    driver: str  # "module:function" -> the driver's name and version
-
-    @property
-    def title(self) -> str:
-        tgt = get_target(self.target)
-        flavor = f" {self.flavor}" if self.flavor else ""
-        return f"{self.backend}: {self.target}{flavor} (guard: {tgt.rules(self.flavor).guard})"
-
-
-PROBES = (
-    Probe("gl", "glsl", "330", "implc.render.eft_probe:run_gl", "implc.render.eft_probe:gl_driver"),
-    Probe("gl", "glsl", "450", "implc.render.eft_probe:run_gl", "implc.render.eft_probe:gl_driver"),
-    Probe("wgpu", "wgsl", None, "implc.render.eft_probe:run_wgpu",
-          "implc.render.eft_probe:wgpu_driver"),
-    Probe("cl", "opencl", None, "implc.render.eft_probe:run_cl",
-          "implc.render.eft_probe:cl_driver"),
-    Probe("hlsl-spirv", "hlsl", None, "implc.render.eft_probe:run_hlsl",
-          "implc.render.eft_probe:gl_driver"),
-    Probe("webgl2", "glsl", "es300", "implc.render.browser_probe:run_webgl2",
-          "implc.render.browser_probe:browser_driver"),
-    Probe("webgpu", "wgsl", None, "implc.render.browser_probe:run_webgpu",
-          "implc.render.browser_probe:browser_driver"),
-)
-BACKENDS = tuple(dict.fromkeys(p.backend for p in PROBES))
+        return f"{self.case.label:<34} {what:<40} {verdict}"
 
 
 @dataclass(frozen=True)
@@ -294,7 +262,8 @@ def wgpu_driver() -> str:
     from ..devices import wgpu_device
 
     info = wgpu_device().adapter.info
-    return f"{info.get('device', '?')}; {info.get('driver', '')} {info.get('driver_info', '')}"
+    return (f"{info.get('device', '?')}; {info.get('backend_type', '')} "
+            f"{info.get('description', '')} (lavapipe when the device is llvmpipe)")
 
 
 def run_cl(text: str, rows: np.ndarray) -> np.ndarray:
