@@ -112,3 +112,13 @@ def test_probe_command_reports_and_exits():
     bad = subprocess.run([sys.executable, "-m", "implc", "probe", "-b", "gl,vulkan"],
                          capture_output=True, text=True, cwd=ROOT, timeout=60)
     assert bad.returncode == 2 and "unknown backend 'vulkan'" in bad.stderr, bad.stderr
+
+
+def test_every_probe_names_what_exists():
+    """Each probe's target, flavour, runner and driver exist (a renamed function or a
+    flavour dropped from the registry fails here, not in `implc probe`)."""
+    for probe in PROBES:
+        target = get_target(probe.target)
+        assert (probe.flavor or target.default_flavor) in target.flavors, probe
+        assert callable(resolve(probe.runner)) and callable(resolve(probe.driver)), probe
+        assert target.eft_probe, probe.target

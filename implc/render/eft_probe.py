@@ -166,7 +166,7 @@ def run_probe(probe: Probe, cases: Sequence[Case] | None = None) -> Report:
     except ToolError as err:
         return Report(probe, "unavailable", unavailable=str(err))
     exact_fma = get_target(probe.target).rules(probe.flavor).fma_exact
-    outcomes = tuple(Outcome(c, float(v), float(e), c.check(F32(v), F32(e)),
+    outcomes = tuple(Outcome(c, float(v), float(e), c.check(float(v), float(e)),
                              c.eft != "two_prod_fma" or exact_fma)
                      for c, (v, e) in zip(cases, pairs, strict=True))
     return Report(probe, driver, outcomes)
@@ -283,8 +283,7 @@ def run_cl(text: str, rows: np.ndarray) -> np.ndarray:
     kernel = cl.Kernel(built.program, "eft_probe")
     kernel.set_args(cases, results)
     cl.enqueue_nd_range_kernel(dev.queue, kernel, (len(rows),), None)
-    cl.enqueue_copy(dev.queue, out, results)
-    dev.queue.finish()
+    cl.enqueue_copy(dev.queue, out, results)  # blocking: waits for the kernel
     return out
 
 
@@ -292,7 +291,8 @@ def cl_driver() -> str:
     from ..devices import opencl_device
 
     dev = opencl_device()
-    return f"{dev.name}; {dev.device.platform.version.strip()}"
+    platform = dev.device.platform  # type: ignore[attr-defined]
+    return f"{dev.name}; {platform.version.strip()}"
 
 
 def probe_all(backends: Sequence[str],
