@@ -237,6 +237,7 @@ def compile_shader(
         "prefix": prefix,
         "flavor": tgt.flavors[flavor],
         "flavor_name": flavor,
+        "rules": tgt.rules(flavor),  # for templates/eft.j2
         "precision": precision,
         "static_params": static_params,
         "declare_params": declare_params,
@@ -264,6 +265,19 @@ def emit(
     """The shader text alone (`compile_shader(...).text`), for callers that need no more."""
     return compile_shader(surface, target, method, constants, flavor, emit_form, prefix,
                           precision, evaluation, params).text
+
+
+def eft_probe_text(target: str, flavor: str | None, ops: dict[str, int], count: int,
+                   prefix: str = "") -> str:
+    """The float32 probe's program of `target` (templates/eft.j2 and its cases, `ops`:
+    name -> number), for `count` cases: what `implc probe` runs on each driver."""
+    tgt = get_target(target)
+    flavor = flavor or tgt.default_flavor
+    printer = tgt.make_printer()
+    return environment(tgt.name).get_template(tgt.eft_probe).render(
+        lang=f"{tgt.name}/lang.j2", types=_types(tgt, "float", prefix), prefix=prefix,
+        rules=tgt.rules(flavor), flavor=tgt.flavors[flavor], ops=ops, count=count,
+        lit={"zero": printer.float_literal(0.0)})
 
 
 def _struct_size(offset: int | None, count: int) -> int:

@@ -60,6 +60,42 @@ GLSL_FLAVORS = {
 
 
 @dataclass(frozen=True)
+class FloatRules:
+    """What one flavour's language offers to keep its compiler from rewriting the
+    error-free transformations of templates/eft.j2 (two_sum's error term is zero in the
+    reals, so a compiler that reassociates or fuses float arithmetic may fold it away).
+    `implc probe` measures whether they survive (docs/reference/float32-probe.md)."""
+
+    # the `precise` qualifier (GLSL 4.00 on, HLSL): what a value is computed from is
+    # neither reassociated nor contracted into an fma
+    precise: bool = False
+    # the float fused multiply-add's spelling; "" where the language has none for float
+    # (GLSL 330 and ES 3.00, hence WebGL2 and Shadertoy; HLSL's fma is double-only, and
+    # its mad may round twice)
+    fma: str = ""
+    # the language promises fma one rounding (OpenCL C); GLSL's and WGSL's take their
+    # accuracy from a*b + c, two roundings allowed. two_prod uses fma only where it
+    # does, else splits its factors (Dekker, Veltkamp); the probe measures both
+    fma_exact: bool = False
+    # a line that turns contraction (a*b + c into an fma) off inside a function body
+    contract_off: str = ""
+    # no guard in the language: each rounded sum the EFTs reason about passes through
+    # min(x, FLT_MAX) (one operation, the identity on every float but NaN), which hides its
+    # definition from pattern-matching rewrites (Mesa's NIR folds an unguarded two_sum's
+    # error to 0: measured by `implc probe` on llvmpipe and lavapipe)
+    barrier: bool = False
+
+    @property
+    def guard(self) -> str:
+        """How the EFTs are guarded, in words (the probe's report, the docs)."""
+        if self.precise:
+            return "precise"
+        if self.barrier:
+            return "min(x, FLT_MAX) barrier (the language has no qualifier)"
+        return self.contract_off or "none"
+
+
+@dataclass(frozen=True)
 class ParamLayout:
     """How the parameters of a `--params uniform` shader reach one emit form
     (docs/reference/drop-ins.md, "Parameters as uniforms"). `{uniform}` is u_param_<name>,
@@ -109,6 +145,15 @@ class Target:
     # flavour -> glslangValidator's flags that turn its program into Vulkan SPIR-V (GPU
     # statistics, render/gpu_stats.py); a flavour not here has no path to SPIR-V
     spirv_flags: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    # flavour -> how its error-free transformations are guarded (FloatRules); a flavour
+    # not here has no guard and no fma
+    float_rules: Mapping[str, FloatRules] = field(default_factory=dict)
+    # the float32 probe's program (templates/eft.j2 run on known inputs: `implc probe`)
+    eft_probe: str = ""
+
+    def rules(self, flavor: str | None = None) -> FloatRules:
+        """The FloatRules of `flavor` (default: the target's default flavour)."""
+        return self.float_rules.get(flavor or self.default_flavor, FloatRules())
 
     @property
     def precisions(self) -> tuple[str, ...]:
@@ -133,6 +178,7 @@ class Target:
 TARGETS: dict[str, Target] = {target.name: target for target in (
     Target(
         name="glsl",
+        eft_probe="glsl/eft_probe.glsl.j2",
         printer_class="implc.backends.glsl:GlslPrinter",
         templates={"program": "glsl/program.glsl.j2", "library": "glsl/library.glsl.j2"},
         emit_extensions={"program": ".frag", "library": ".glsl"},
@@ -158,9 +204,14 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         stages=("vert", "frag", "comp", "geom", "tesc", "tese"),
         # Vulkan's relaxed rules: the plain uniforms become one block at set 0, binding 0
         spirv_flags={flavor: ("-R", "--aml", "--amb") for flavor in ("330", "450")},
+        # `precise` and fma came with GLSL 4.00 (ARB_gpu_shader5); 330 and ES 3.00 have
+        # neither (nor has Shadertoy, which is WebGL2)
+        float_rules={"450": FloatRules(precise=True, fma="fma"),
+                     **{f: FloatRules(barrier=True) for f in ("330", "es300", "shadertoy")}},
     ),
     Target(
         name="wgsl",
+        eft_probe="wgsl/eft_probe.wgsl.j2",
         printer_class="implc.backends.wgsl:WgslPrinter",
         templates={"program": "wgsl/program.wgsl.j2", "library": "wgsl/library.wgsl.j2"},
         emit_extensions={"program": ".wgsl", "library": ".wgsl"},
@@ -175,9 +226,13 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
                       "library": ParamLayout(ref="{prefix}params.{uniform}")},
         vector_types={"float": ("f32", "vec2<f32>", "vec3<f32>", "vec4<f32>")},
         int_type="i32",
+        # WGSL's fma may be computed as e1 * e2 + e3 (its accuracy is "inherited" from
+        # that: two roundings allowed), so two_prod splits its factors there too
+        float_rules={"default": FloatRules(fma="fma", barrier=True)},
     ),
     Target(
         name="opencl",
+        eft_probe="opencl/eft_probe.opencl.j2",
         printer_class="implc.backends.opencl:OpenclPrinter",
         templates={"program": "opencl/program.opencl.j2",
                    "library": "opencl/library.opencl.j2"},
@@ -199,9 +254,13 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         params_read_as="argument",
         param_layout={"program": ParamLayout(ref="params.{uniform}"),
                       "library": ParamLayout(ref="params.{uniform}")},
+        # OpenCL C contracts by default (FP_CONTRACT ON); fma is correctly rounded
+        float_rules={"default": FloatRules(fma="fma", fma_exact=True,
+                                           contract_off="#pragma OPENCL FP_CONTRACT OFF")},
     ),
     Target(
         name="hlsl",
+        eft_probe="hlsl/eft_probe.hlsl.j2",
         printer_class="implc.backends.hlsl:HlslPrinter",
         templates={"program": "hlsl/program.hlsl.j2", "library": "hlsl/library.hlsl.j2"},
         emit_extensions={"program": ".hlsl", "library": ".hlsl"},
@@ -215,8 +274,50 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         param_layout={"program": ParamLayout(),
                       "library": ParamLayout("{prefix}{uniform}", "{prefix}{uniform}")},
         spirv_flags={"default": ("-D", "-e", "main")},  # glslang's HLSL front end
+        float_rules={"default": FloatRules(precise=True)},
     ),
 )}
+
+
+@dataclass(frozen=True)
+class Probe:
+    """A driver the float32 probe (`implc probe`, render/eft_probe.py) runs on: a backend
+    (a render backend, or a browser's), the language and flavour it compiles, the
+    function that runs the program ((text, cases as (op, a, b, n) rows) -> pairs) and the
+    one that names the driver and its version."""
+
+    backend: str
+    target: str
+    flavor: str | None
+    runner: str  # "module:function"
+    driver: str  # "module:function" -> the driver's name and version
+
+    @property
+    def title(self) -> str:
+        tgt = get_target(self.target)
+        flavor = f" {self.flavor}" if self.flavor else ""
+        return f"{self.backend}: {self.target}{flavor} (guard: {tgt.rules(self.flavor).guard})"
+
+
+# every float32 driver implc runs; webgl2 also stands for Shadertoy (WebGL2 in a page)
+PROBES = (
+    Probe("gl", "glsl", "330", "implc.render.eft_probe:run_gl",
+          "implc.render.eft_probe:gl_driver"),
+    Probe("gl", "glsl", "450", "implc.render.eft_probe:run_gl",
+          "implc.render.eft_probe:gl_driver"),
+    Probe("wgpu", "wgsl", None, "implc.render.eft_probe:run_wgpu",
+          "implc.render.eft_probe:wgpu_driver"),
+    Probe("cl", "opencl", None, "implc.render.eft_probe:run_cl",
+          "implc.render.eft_probe:cl_driver"),
+    Probe("hlsl-spirv", "hlsl", None, "implc.render.eft_probe:run_hlsl",
+          "implc.render.eft_probe:gl_driver"),
+    Probe("webgl2", "glsl", "es300", "implc.render.browser_probe:run_webgl2",
+          "implc.render.browser_probe:browser_driver"),
+    Probe("webgpu", "wgsl", None, "implc.render.browser_probe:run_webgpu",
+          "implc.render.browser_probe:browser_driver"),
+)
+PROBE_BACKENDS = tuple(dict.fromkeys(p.backend for p in PROBES))
+
 
 
 def get_target(name: str) -> Target:

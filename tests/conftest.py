@@ -7,6 +7,8 @@ import shutil
 
 import pytest
 
+import implc.chromium as _chromium
+
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 
 
@@ -72,22 +74,9 @@ def require_validator(target: str):
 
 
 # --- the real browser (tests/test_view.py, tests/test_browser.py) --------------------------
-# Headless Chromium on this GPU-less machine: WebGL2 through ANGLE on SwiftShader, and
-# WebGPU through Dawn on SwiftShader's Vulkan. `--enable-unsafe-webgpu` and
-# `--use-webgpu-adapter=swiftshader` give WebGPU an adapter; presenting to a WebGPU
-# canvas also needs `--enable-features=Vulkan --use-vulkan=swiftshader` (without them
-# compute work runs but a canvas frame fails with "A valid external Instance reference no
-# longer exists"). `--allow-file-access-from-files` lets a file:// page import the
-# three.js ES modules beside it (module scripts need CORS, which file:// lacks).
-CHROMIUM_FLAGS = (
-    "--enable-unsafe-webgpu",
-    "--use-webgpu-adapter=swiftshader",
-    "--enable-features=Vulkan",
-    "--use-vulkan=swiftshader",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-    "--allow-file-access-from-files",
-)
+# Headless Chromium on this GPU-less machine, with implc's flags (implc/chromium.py: why
+# each is needed), which the float32 probe's browser drivers use too.
+CHROMIUM_FLAGS = _chromium.CHROMIUM_FLAGS
 
 
 def _require(what: str, reason: str):
@@ -98,8 +87,7 @@ def _require(what: str, reason: str):
 
 def chromium_path() -> str:
     """The system Chromium (Debian's `chromium`; IMPLC_CHROMIUM overrides)."""
-    path = os.environ.get("IMPLC_CHROMIUM") or shutil.which("chromium") \
-        or shutil.which("chromium-browser")
+    path = _chromium.chromium_path()
     if not path:
         _require("chromium", "no chromium on PATH")
     return path

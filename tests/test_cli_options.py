@@ -51,7 +51,7 @@ BAD_OPTIONS = [
     (["compile", "sphere", "-m", "hesian"], "; did you mean 'hessian'?"),
     (["rendr", "sphere"], "invalid choice: 'rendr' (choose from 'list', 'show', 'compile', "
                           "'export', 'validate', 'render', 'view', 'compare', 'bench', "
-                          "'corpus', 'gallery'); did you mean 'render'?"),
+                          "'corpus', 'gallery', 'probe'); did you mean 'render'?"),
     (["compile", "sphere", "-t", "bogus"], "invalid choice: 'bogus'"),
     (["compile", "sphere", "--flavor", "300es"],
      "--flavor: unknown glsl flavour '300es'; choose from 330, 450, es300, shadertoy"),

@@ -43,14 +43,14 @@ FSIZE = 64  # bytes: under RLIMIT_FSIZE every output (and temp file) is larger
 SLOW = "sin(" * 34 + "x*y*z" + ")" * 34  # ~2.6 s of CPU in derive + CSE
 
 COMMANDS = ("list", "show", "compile", "validate", "render", "compare", "bench", "corpus",
-            "view", "gallery", "export")
+            "view", "gallery", "export", "probe")
 FAULTS = ("missing input", "unreadable input", "directory input", "directory output",
           "unwritable output", "full disk", "SIGINT", "SIGTERM")
-STDOUT_ONLY = {"list", "show", "validate", "compare"}
-NO_INPUT = {"list"}
+STDOUT_ONLY = {"list", "show", "validate", "compare", "probe"}
+NO_INPUT = {"list", "probe"}
 # (command, fault) -> why it does not apply
 NOT_APPLICABLE = {
-    **{("list", f): "list reads no input" for f in
+    **{(c, f): f"{c} reads no input" for c in NO_INPUT for f in
        ("missing input", "unreadable input", "directory input")},
     **{(c, "directory output"): f"{c} writes standard output only" for c in STDOUT_ONLY},
     **{("gallery", f): "gallery shows a surface's input error in its cell and goes on "
@@ -124,6 +124,7 @@ def argv(cmd: str, inp: str, out: str, place: Path) -> list[str]:
         "corpus": ["corpus", inp, "--rows", "1-3", "-j", "1", "--no-validate", "-o", out],
         "gallery": ["gallery", inp, "--size", "16", "-o", out],
         "export": ["export", inp, "--host", "unity", "-o", out],
+        "probe": ["probe", "-b", "gl"],
     }[cmd]
 
 
@@ -177,7 +178,7 @@ def check_one_line(proc_stderr: str, code: int, expected_code: int, needle: str)
 
 
 def needs_tools(cmd: str) -> None:
-    if cmd in ("render", "bench", "gallery"):
+    if cmd in ("render", "bench", "gallery", "probe"):
         require_gl()
     if cmd == "validate":
         require_tool("glslangValidator")
@@ -386,4 +387,4 @@ def test_matrix_is_complete():
     sub = next(a for a in parser._actions if a.dest == "command")
     assert set(sub.choices) == set(COMMANDS)
     applicable = [case for case in CASES if case not in NOT_APPLICABLE]
-    assert len(applicable) == len(CASES) - len(NOT_APPLICABLE) == 78
+    assert len(applicable) == len(CASES) - len(NOT_APPLICABLE) == 82

@@ -29,6 +29,7 @@ from .cmd_corpus import run as cmd_corpus
 from .cmd_export import run as cmd_export
 from .cmd_gallery import run as cmd_gallery
 from .cmd_list import run as cmd_list
+from .cmd_probe import run as cmd_probe
 from .cmd_render import run as cmd_render
 from .cmd_show import run as cmd_show
 from .cmd_validate import run as cmd_validate
@@ -78,6 +79,6 @@ def _run(args: argparse.Namespace) -> int:
 
 __all__ = [
     "LIMIT_FLAGS", "UsageError", "build_parser", "cmd_bench", "cmd_compare", "cmd_compile",
-    "cmd_corpus", "cmd_export", "cmd_gallery", "cmd_list", "cmd_render", "cmd_show", "cmd_validate",
-    "cmd_view", "main",
+    "cmd_corpus", "cmd_export", "cmd_gallery", "cmd_list", "cmd_probe", "cmd_render",
+    "cmd_show", "cmd_validate", "cmd_view", "main",
 ]

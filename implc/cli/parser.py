@@ -25,10 +25,12 @@ examples:
   implc view torus -o torus.html
   implc compare cc-hessian.exr cc-reference.exr
   implc bench cross-cap miter steiner --size 512 -o results/
+  implc probe -b gl,wgpu,cl
 
 exit codes: 0 ok, 1 bad input or output (file missing, unreadable or unwritable,
-            disk full), 2 bad command line, 3 validation failed, 4 tool or runtime
-            missing, 70 internal error (IMPLC_DEBUG=1 shows the traceback),
+            disk full), 2 bad command line, 3 validation failed (probe: a driver
+            lost an error-free transformation), 4 tool or runtime missing, 70
+            internal error (IMPLC_DEBUG=1 shows the traceback),
             130 interrupted (SIGINT), 143 terminated (SIGTERM)
 """
 
@@ -76,6 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .cmd_export import add_parser as add_export
     from .cmd_gallery import add_parser as add_gallery
     from .cmd_list import add_parser as add_list
+    from .cmd_probe import add_parser as add_probe
     from .cmd_render import add_parser as add_render
     from .cmd_show import add_parser as add_show
     from .cmd_validate import add_parser as add_validate
@@ -90,7 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"implc {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for add in (add_list, add_show, add_compile, add_export, add_validate, add_render,
-                add_view, add_compare, add_bench, add_corpus, add_gallery):
+                add_view, add_compare, add_bench, add_corpus, add_gallery, add_probe):
         add(sub)
     return parser
 

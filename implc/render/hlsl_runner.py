@@ -1,5 +1,5 @@
 """Run a generated HLSL pixel shader headlessly: glslangValidator's HLSL front end compiles
-it to SPIR-V (as `implc validate` does), spirv-cross translates the SPIR-V to GLSL 330,
+it to SPIR-V (as `implc validate` does), spirv-cross translates the SPIR-V to GLSL 400,
 and the GL runner draws it (moderngl, EGL; llvmpipe here).
 
 Why this path and not wgpu taking the SPIR-V on lavapipe: the SPIR-V is the HLSL
@@ -45,7 +45,7 @@ def toolchain() -> tuple[str, ...]:
 
 
 def hlsl_to_glsl(hlsl: str, include_dirs: Sequence[str] = ()) -> str:
-    """HLSL pixel shader (entry point main) -> SPIR-V -> GLSL 330 core with plain uniforms
+    """HLSL pixel shader (entry point main) -> SPIR-V -> GLSL 400 core with plain uniforms
     (`include_dirs`: where its #include files are, as glslang's -I)."""
     glslang = toolchain()[0]
     with tempfile.TemporaryDirectory(prefix="implc-") as tmp:
@@ -57,10 +57,13 @@ def hlsl_to_glsl(hlsl: str, include_dirs: Sequence[str] = ()) -> str:
 
 
 def spirv_to_glsl(spirv: str) -> str:
-    """A SPIR-V pixel shader's file (any HLSL front end's output) -> GLSL 330 core with
+    """A SPIR-V pixel shader's file (any HLSL front end's output) -> GLSL 400 core with
     plain uniforms."""
     cross = toolchain()[1]
-    return plain_uniforms(_run([cross, "--version", "330", "--no-es",
+    # 400, not 330: GLSL before 4.00 has no `precise`, and spirv-cross drops the HLSL's
+    # (SPIR-V's NoContraction) in it, letting the GL driver fold the error-free
+    # transformations of templates/eft.j2 (measured: `implc probe -b hlsl-spirv`)
+    return plain_uniforms(_run([cross, "--version", "400", "--no-es",
                                 "--glsl-emit-ubo-as-plain-uniforms", spirv]))
 
 
