@@ -385,3 +385,22 @@ def test_a_sum_of_monomials_on_the_grid_is_the_walkers_value():
         slow = np.broadcast_to(evaluate(e, dict(zip(POINT, grid, strict=True))), fast.shape)
         assert fast.shape == (17, 13, 11)
         assert np.allclose(fast, slow, rtol=1e-12, atol=1e-12 * np.abs(slow).max()), text
+
+
+def test_an_expanded_polynomial_keeps_the_walkers_signs():
+    """A polynomial written factored (degree <= EXPAND_UP_TO) is expanded and contracted
+    too, and where the expanded form's rounding could decide a sign the walker's value is
+    taken: Wilkinson's product (x-1)(x-2)...(x-16), whose expanded coefficients reach
+    2e13 and cancel near its roots (18 of these grid points get the wrong sign from the
+    expanded form alone), keeps the walker's sign at every point."""
+    from implc.numeric import _checked_contraction, _expanded, evaluate, evaluate_on_grid
+    from implc.symbols import POINT
+
+    axes = [np.linspace(-120.0, 120.0, 801), np.linspace(-1.0, 1.0, 5),
+            np.linspace(-1.0, 1.0, 3)]
+    grid = np.meshgrid(*axes, indexing="ij")
+    e = expr("*".join(f"(x-{i})" for i in range(1, 17)) + " + y^2 + z^2 - 1/100")
+    assert _checked_contraction(e, _expanded(e), axes) is not None  # the expanded route
+    fast = evaluate_on_grid(e, axes)
+    slow = np.broadcast_to(evaluate(e, dict(zip(POINT, grid, strict=True))), fast.shape)
+    assert (np.sign(fast) == np.sign(slow)).all()
