@@ -117,6 +117,42 @@ def test_bench_writes_tables_figure_and_renders(tmp_path):
     assert not list(out.rglob(".*"))  # no temporary files left behind
 
 
+def test_bench_gives_each_programs_gpu_statistics(tmp_path):
+    """`bench --gpu-stats`: each cell's program compiled for HLSL with its method and
+    constants gets RADV/ACO's figures, the same as `Shader.gpu_stats` gives for that
+    program, in table.md (beside the frame ratio) and in each cell of table.json."""
+    from conftest import _require, require_tool
+
+    from implc.render.gpu_stats import gpu_stats, radv_problem
+
+    require_gl()
+    require_tool("glslangValidator")
+    if problem := radv_problem():
+        _require("Mesa's RADV", problem)
+    out = tmp_path / "results"
+    proc = implc("bench", "torus", "--size", "32", "--frames", "1", "--methods", "taylor",
+                 "exact", "--configs", "paper,equal", "--gpu-stats", "--gpu-family", "navi21",
+                 "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    torus = load_surface("torus")
+    data = json.loads((out / "table.json").read_text())
+    table = (out / "table.md").read_text()
+    assert "## what a GPU's compiler says" in table
+    for config in data["configs"]:
+        overrides = make_configs([config["name"]], 0.002)[0].overrides
+        for method, cell in config["results"]["torus"].items():
+            from implc.emit import compile_shader
+
+            shader = compile_shader(torus, "hlsl", method, METHODS[method].constants(**overrides))
+            (expected,) = gpu_stats([shader], ["navi21"])["navi21"]
+            got = cell["gpu_stats"]["navi21"]
+            assert got == expected.as_dict()
+            assert (f"| {config['name']} | torus | {method} | {cell['ratio_to_taylor']:.2f} | "
+                    f"{got['vgprs']} / {got['waves']} / {got['instructions']} |") in table
+    alone = implc("bench", "torus", "--gpu-family", "navi21", "-o", str(tmp_path / "x"))
+    assert alone.returncode == 2 and "--gpu-stats" in alone.stderr
+
+
 def test_bench_rejects_bad_arguments(tmp_path):
     surfaces = {"cross-cap": load_surface("cross-cap")}
     for bad in ({"size": 0}, {"frames": 0}, {"methods": ["nope"]}, {"backend": "reference"},

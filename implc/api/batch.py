@@ -37,11 +37,14 @@ def gallery(surfaces: Sequence[str], out_dir: str | Path, *, size: int = 160,
 def benchmark(surfaces: Sequence[str], out_dir: str | Path, *, size: int = 1024,
           methods: Sequence[str] | None = None, frames: int = 3, backend: str = "gl",
           configs: Sequence[str] | None = None, equal_step: float | None = None,
-          exr: bool = False, baseline: bool = False, executor: Executor | None = None,
+          exr: bool = False, baseline: bool = False, gpu_families: Sequence[str] = (),
+          executor: Executor | None = None,
           progress: TextIO | None = sys.stderr) -> BenchRun:
     """The paper's Table 1 over `surfaces` (files or example names): every method timed
     in turns on this machine, each against the exact CPU reference (computed on
-    `executor` when one is given: the timing itself always runs here, alone)."""
+    `executor` when one is given: the timing itself always runs here, alone). With
+    `gpu_families` (e.g. ("navi21",)), each cell's program compiled for HLSL also gets
+    RADV/ACO's statistics on those AMD families (`BenchRun.gpu_stats`)."""
     from ..bench import CONFIG_NAMES, DEFAULT_METHODS, EQUAL_STEP, run_bench
     from .surface import Surface
 
@@ -57,7 +60,8 @@ def benchmark(surfaces: Sequence[str], out_dir: str | Path, *, size: int = 1024,
     return run_bench(framed, Path(out_dir), size=size, methods=methods or DEFAULT_METHODS,
                      frames=frames, backend=backend, configs=configs or CONFIG_NAMES,
                      equal_step=EQUAL_STEP if equal_step is None else equal_step, exr=exr,
-                     baseline=baseline, progress=progress, executor=executor)
+                     baseline=baseline, gpu_families=tuple(gpu_families), progress=progress,
+                     executor=executor)
 
 
 def check_corpus(rows: Iterable[Row], targets: Sequence[str] | None = None, *,

@@ -105,6 +105,7 @@ def run_bench(
     equal_step: float = EQUAL_STEP,
     exr: bool = False,
     baseline: bool = False,
+    gpu_families: Sequence[str] = (),
     progress: TextIO | None = sys.stderr,
     executor: Executor | None = None,
 ) -> BenchRun:
@@ -115,7 +116,8 @@ def run_bench(
     in the same rounds as the generated ones.
     Progress goes to `progress`: a bar with an ETA on a terminal, numbered lines otherwise.
     The references are computed on `executor` when one is given (the frames are always
-    timed here, alone).
+    timed here, alone). With `gpu_families`, each cell's program compiled for HLSL gets
+    RADV/ACO's statistics (`BenchRun.gpu_stats`), asked once per family for all cells.
     """
     _check_args(surfaces, size, methods, frames, backend, equal_step)
     bench_configs = make_configs(configs, equal_step)
@@ -125,6 +127,8 @@ def run_bench(
     with staged_directory(out_dir) as stage:
         run = _measure(surfaces, stage, size, methods, frames, backend, bench_configs, exr,
                        progress, baseline, executor)
+        if gpu_families:
+            _gpu_stats(run, gpu_families, _printer(progress))
         write_outputs(run, stage)
     _printer(progress)(f"wrote {out_dir / 'table.md'}, table.json, figure.png, renders/")
     return run
@@ -221,6 +225,23 @@ def _measure_surface(run, config, chosen, key, surface, reference, renders, exr,
         run.baseline_cells[config.name, key, method] = Cell(
             fps, seconds[index], 0.0, compiled[index], compare(results[index], reference), "")
         bar.note(f"{key} {method} {config.name}, hand-written baseline: {fps:.3g} fps")
+
+
+def _gpu_stats(run: BenchRun, families: Sequence[str], say) -> None:
+    """RADV/ACO's statistics of every cell's program as HLSL (the path to SPIR-V that
+    every method has), the cell's method and constants."""
+    from ..emit import compile_shader
+    from ..render.gpu_stats import gpu_stats
+
+    keys = list(run.cells)
+    configs = {c.name: c for c in run.configs}
+    shaders = [compile_shader(run.surfaces[key], "hlsl", method,
+                              METHODS[method].constants(**configs[config].overrides))
+               for config, key, method in keys]
+    say(f"gpu statistics: {len(shaders)} program(s) on {', '.join(families)} (RADV/ACO)")
+    for family, rows in gpu_stats(shaders, families).items():
+        for cell, stats in zip(keys, rows, strict=True):
+            run.gpu_stats.setdefault(cell, {})[family] = stats.as_dict()
 
 
 def _check_args(surfaces, size, methods, frames, backend, equal_step) -> None:

@@ -101,6 +101,9 @@ class BenchRun:
     # the hand-written programs, timed in turns with the generated ones
     baseline_cells: dict[tuple[str, str, str], Cell] = field(default_factory=dict)
     tiles: dict[tuple[str, str, str], object] = field(default_factory=dict)  # PIL thumbnails
+    # (config, surface, method) -> family -> RADV/ACO's figures of the cell's HLSL program
+    # (render.gpu_stats.GpuStats.as_dict), with --gpu-stats
+    gpu_stats: dict[tuple[str, str, str], dict[str, dict]] = field(default_factory=dict)
 
     def config_methods(self, config: BenchConfig) -> list[str]:
         return config.applies_to(self.methods)

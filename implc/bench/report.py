@@ -52,7 +52,7 @@ def table_json(run: BenchRun) -> dict:
                 "constants": {m: METHODS[m].constants(**c.overrides).as_dict()
                               for m in run.config_methods(c)},
                 "results": {
-                    key: {m: run.cells[c.name, key, m].as_json()
+                    key: {m: _cell_json(run, (c.name, key, m))
                           for m in run.config_methods(c) if (c.name, key, m) in run.cells}
                     for key in run.surfaces
                 },
@@ -65,6 +65,14 @@ def table_json(run: BenchRun) -> dict:
         "paper_table1": {k: {m: {"fps": v[0], "ssim": v[1]} for m, v in row.items()}
                          for k, row in PAPER_TABLE1.items()},
     }
+
+
+def _cell_json(run: BenchRun, cell: tuple[str, str, str]) -> dict:
+    """A cell's measurement, with its program's GPU statistics when they were asked for."""
+    data = run.cells[cell].as_json()
+    if cell in run.gpu_stats:
+        data["gpu_stats"] = run.gpu_stats[cell]
+    return data
 
 
 def write_outputs(run: BenchRun, out_dir: Path) -> list[Path]:
@@ -146,6 +154,7 @@ def format_markdown(run: BenchRun) -> str:
             lines.append(f"| {key} | " + " | ".join(cells) + " |")
         lines.append("")
     lines += _baseline_table(run)
+    lines += _gpu_table(run)
     lines += _paper_comparison(run)
     return "\n".join(lines)
 
@@ -174,6 +183,38 @@ def _baseline_table(run: BenchRun) -> list[str]:
         lines.append(f"| {config} | {key} | {method} | {step:g} | {generated.fps:.3g} | "
                      f"{hand.fps:.3g} | {generated.fps / hand.fps:.2f} | "
                      f"{m['false_hits']} / {m['missed_hits']} / {m['wrong_root']} |")
+    lines.append("")
+    return lines
+
+
+def _gpu_table(run: BenchRun) -> list[str]:
+    """What AMD's compiler makes of each cell's program (--gpu-stats): beside the frame
+    ratio, which llvmpipe measures on a CPU, the registers that decide a GPU's speed."""
+    if not run.gpu_stats:
+        return []
+    families = list(next(iter(run.gpu_stats.values())))
+    lines = [
+        "## what a GPU's compiler says (RADV/ACO, no GPU: HLSL through SPIR-V)",
+        "",
+        "Each cell's program compiled for HLSL with its method and constants, the fragment "
+        "stage as ACO compiles it on Mesa's RADV null device per AMD family. Cell: "
+        "`VGPRs / waves per SIMD / instructions`, and the spills if any. The ratio is the "
+        "llvmpipe frame's, from the tables above.",
+        "",
+        "| config | surface | method | fps / taylor's | " + " | ".join(families) + " |",
+        "|---|---|---|---|" + "---|" * len(families),
+    ]
+    for (config, key, method), by_family in run.gpu_stats.items():
+        ratio = run.cells[config, key, method].ratio_to_taylor
+        cells = []
+        for family in families:
+            g = by_family[family]
+            spill = (f" (spills {g['spilled_vgprs']} VGPRs, {g['spilled_sgprs']} SGPRs, "
+                     f"{g['scratch']} B)" if g["spilled_vgprs"] or g["spilled_sgprs"]
+                     or g["scratch"] else "")
+            cells.append(f"{g['vgprs']} / {g['waves']} / {g['instructions']}{spill}")
+        lines.append(f"| {config} | {key} | {method} | "
+                     f"{'–' if ratio is None else f'{ratio:.2f}'} | " + " | ".join(cells) + " |")
     lines.append("")
     return lines
 

@@ -17,6 +17,7 @@ from ..options import (
     AUTO_RAY_POLY_MAX_DEGREE,
     EVAL_CHOICES,
     EXACT_MAX_DEGREE,
+    GPU_FAMILIES,
     METHOD_NAMES,
     TAYLOR2_CHOICES,
     Constants,
@@ -354,6 +355,29 @@ def warn_ignored(args: argparse.Namespace, method: str, reference: bool = False)
         warn(args, f"{_spoken(ignored)} not apply to method {method}{which}, which "
                    f"reads {', '.join(used) if used else 'none of the method constants'}: "
                    "ignored")
+
+
+def gpu_family_arg(g: Any) -> None:
+    """--gpu-family, shared by `show --gpu-stats` and `bench --gpu-stats`."""
+    g.add_argument("--gpu-family", default=None, dest="gpu_family", metavar="F1,F2",
+                   help=f"RADV family names (default {','.join(GPU_FAMILIES)}: RDNA2, RDNA3; "
+                        "e.g. polaris10 for GCN)")
+
+
+def gpu_families(args: argparse.Namespace) -> tuple[str, ...]:
+    """The families asked for with --gpu-stats (OptionError: a family option without it,
+    or a name that is not one)."""
+    if not args.gpu_stats:
+        if args.gpu_family:
+            raise OptionError("--gpu-family applies with --gpu-stats only")
+        return ()
+    from ..render.gpu_stats import check_family
+
+    named = (args.gpu_family or ",".join(GPU_FAMILIES)).split(",")
+    families = tuple(check_family(f.strip()) for f in named if f.strip())
+    if not families:
+        raise OptionError("--gpu-family: name at least one family, e.g. navi21")
+    return families
 
 
 def executor_args(p: argparse.ArgumentParser, default_jobs: int) -> None:

@@ -40,6 +40,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="also time the hand-written GLSL of templates/baseline/ (Cross-Cap, "
                         "taylor and hessian; gl) in turns with the generated programs and "
                         "report generated / hand-written speed")
+    g = p.add_argument_group("GPU statistics (Mesa's RADV on a null device: no GPU needed)")
+    g.add_argument("--gpu-stats", action="store_true", dest="gpu_stats",
+                   help="also give each cell's program as AMD's compiler (ACO) makes it, "
+                        "compiled for HLSL with the cell's method and constants: VGPRs, "
+                        "waves per SIMD, instructions, spills (a table in table.md, and "
+                        "`gpu_stats` in each cell of table.json)")
+    common.gpu_family_arg(g)
     common.executor_args(p, default_jobs=1)
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="output directory (created if missing)")
@@ -57,10 +64,11 @@ def run(args: argparse.Namespace) -> int:
     twice = [m for i, m in enumerate(args.methods or ()) if m in args.methods[:i]]
     if twice:
         raise UsageError(f"--methods: {twice[0]} is listed twice")
+    families = common.gpu_families(args)
     check_output_dir(args.output, what="bench output directory")
     with common.executor(args) as executor:
         benchmark(args.surfaces, args.output, size=args.size, methods=args.methods,
               frames=args.frames, backend=args.backend, configs=configs,
               equal_step=args.equal_step, exr=args.exr, baseline=args.baseline,
-              executor=executor)
+              gpu_families=families, executor=executor)
     return EXIT_OK

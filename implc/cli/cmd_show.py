@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import EXIT_OK, OptionError
-from ..options import GPU_FAMILIES, METHOD_NAMES
+from ..options import METHOD_NAMES
 from . import args as common
 
 # the programs that reach SPIR-V, per precision: (target, flavour)
@@ -25,10 +25,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="also print what AMD's compiler (ACO) makes of the method's program "
                         "for each family: VGPRs, SGPRs, spills, scratch, waves per SIMD, "
                         "instructions (HLSL and GLSL 450 programs through SPIR-V)")
-    g.add_argument("--gpu-family", default=None, dest="gpu_family",
-                   metavar="F1,F2",
-                   help=f"RADV family names (default {','.join(GPU_FAMILIES)}: RDNA2, RDNA3; "
-                        "e.g. polaris10 for GCN)")
+    common.gpu_family_arg(g)
     g.add_argument("--precision", choices=sorted(SPIRV_PROGRAMS), default=None,
                    help="precision of the programs measured (double: GLSL 450 only, HLSL "
                         "has float only; default float)")
@@ -37,14 +34,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if not args.gpu_stats and (args.gpu_family or args.precision):
         raise OptionError("--gpu-family and --precision apply with --gpu-stats only")
-    families = [f.strip() for f in (args.gpu_family or ",".join(GPU_FAMILIES)).split(",")]
+    families = common.gpu_families(args)
     precision = args.precision or "float"
-    if args.gpu_stats:
-        from ..render.gpu_stats import check_family
-
-        families = [check_family(f) for f in families if f]
-        if not families:
-            raise OptionError("--gpu-family: name at least one family, e.g. navi21")
     surface = common.surface(args)
     print(surface.describe(args.method))
     if args.gpu_stats:
