@@ -98,17 +98,19 @@ def solver_program(name: str, surface: Surface, constants: Constants,
     programs = build_programs(expr, (("S",), ("grad",)), surface.limits.max_derived)
     functions = [point_function(f, program, printer) for f, program in programs.items()]
     _, ray = ray_setup(coefficient_program(expr, precision), printer, size=False)
-    # level k (D_(n-k)) -> its coefficients' factors C(j + n - k, n - k), None for 1
-    binom = {k: [None if comb(j + degree - k, degree - k) == 1 else
-                 printer.float_literal(float(comb(j + degree - k, degree - k)))
-                 for j in range(k + 1)] for k in range(2, degree + 1)}
+    # level k (D_m = F^(m)/m!, m = n - k) -> i -> (i+1)/(i+1-m), the ratio of its
+    # coefficients' binomials C(i+1, m)/C(i, m) (None for 1), for Horner's rule on x
+    ratios = {k: {i: None if k == degree else printer.float_literal((i + 1) / (i + 1 - degree + k))
+                  for i in range(degree - k, degree)} for k in range(3, degree + 1)}
     real, vec2, vec3, vec4 = target.vector_types[precision]
     shading = print_shading(surface.view, target.make_printer("float"))
     return render_template(
         solver.template, n=degree, flavor=target.flavors[flavor],
         double=precision == "double",
         types={"real": real, "vec2": vec2, "vec3": vec3, "vec4": vec4},
-        functions=functions, ray=ray, binom=binom,
+        functions=functions, ray=ray, w=ratios,
+        q1=printer.float_literal(float(degree - 1)),
+        q2=printer.float_literal(float(comb(degree, 2))),
         xtol=printer.float_literal(constants.xtol), ctol=printer.float_literal(constants.ctol),
         max_steps=SOLVER_MAX_STEPS, shading=shading)
 
