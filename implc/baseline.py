@@ -12,12 +12,16 @@ generated / baseline speed.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from .emit import CompiledShader, print_shading, render_template
 from .errors import InputError
 from .methods import Constants
 from .surface import Surface
 from .targets import get_target
+
+if TYPE_CHECKING:
+    from .render.gl import GlRunner
 
 # (surface key, method) -> whether its hand-written test is second order (Eq. 4, F''
 # in the interval) rather than first order (Eq. 3): the one switch of the template.
@@ -116,7 +120,7 @@ def solver_program(name: str, surface: Surface, constants: Constants,
 
 
 def open_solver_runner(name: str, surface: Surface, constants: Constants, width: int,
-                       height: int, precision: str = "float"):
+                       height: int, precision: str = "float") -> GlRunner:
     """The GL runner (llvmpipe here) of the hand-written solver's program."""
     from .render.gl import GlRunner
 

@@ -4,7 +4,7 @@ implc/baseline.py SOLVERS), on the same ray polynomial, camera and shading
 (docs/RESULTS.md, "The strongest published solver as a baseline").
 
     python scripts/yuksel_baseline.py --size 512 --degrees 4,10,16,20 barth-decic
-    python scripts/yuksel_baseline.py --size 512 --count-size 512,16=128,20=96 --write docs/RESULTS.md
+    python scripts/yuksel_baseline.py --count-size 512,16=128,20=96 --write docs/RESULTS.md
 
 Per row (Chmutov's T_n of eval_forms' sweep, or a named surface): both programs, and
 Barth's hand-written decic where the surface has one, timed in turns on llvmpipe (one
@@ -129,9 +129,9 @@ def main() -> None:
              f"{args.frames} frames in turns after a warm-up, medians; counts against the "
              "certified reference; ACO: RADV's null devices, GLSL 450). "
              "VGPRs / waves per SIMD / instructions, spills where there are any:", "",
-             f"| surface | degree | solved in | exact ms | Yuksel ms | exact speed / Yuksel "
-             f"| hand-written decic ms | counted at | exact false / missed / wrong | Yuksel "
-             f"false / missed / wrong | Yuksel steps a pixel | "
+             "| surface | degree | solved in | exact ms | Yuksel ms | exact speed / Yuksel "
+             "| hand-written decic ms | counted at | exact false / missed / wrong | Yuksel "
+             "false / missed / wrong | Yuksel steps a pixel | "
              + " | ".join(f"exact {f} | Yuksel {f}" for f in GPU_FAMILIES) + " |",
              "|---|---|---|---|---|---|---|---|---|---|---|" + "---|" * 2 * len(GPU_FAMILIES)]
     print("\n".join(lines), flush=True)
