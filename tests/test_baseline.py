@@ -84,10 +84,12 @@ def test_solver_baseline_validates(name, degree, precision):
 @pytest.mark.parametrize(("name", "degree"), [("yuksel", 4), ("yuksel", 10)])
 def test_solver_baseline_finds_the_references_roots(name, degree):
     """Chmutov's T4 and T10 at 96x96, in float32 (which holds them): the hand-written
-    solver hits where the reference hits, at its root. Measured 0 / 0 / 0 for both (and
-    0 / 0 / 0 at 512^2, docs/RESULTS.md); the bound is the decic baseline's, 1 false hit
-    and 2 missed or wrong pixels of 9,216, since Yuksel's solver has no touching-root test
-    (a ray grazing a sheet closer than float32 resolves can fall either way)."""
+    solver hits where the reference hits, at its root. Measured 0 / 0 / 0 for both here
+    (at 512^2, docs/RESULTS.md: T4 0 / 0 / 0, T10 1 / 1 / 11 of 262,144); the bound is the
+    decic baseline's, 1 false hit and 2 missed or wrong pixels of 9,216, since Yuksel's
+    solver has no touching-root test (a ray grazing a sheet closer than float32 resolves
+    can fall either way). With the collapse of a rootless interval broken (onto lo instead
+    of the level's previous root, so the levels' roots are no longer sorted), T10 had 89."""
     require_gl()
     surface = load_surface(equation=chmutov(degree))
     constants = METHODS["exact"].defaults
