@@ -1,6 +1,7 @@
 """The frame table for a machine with a real GPU (issue 49): every method (exact, taylor,
 hessian, interval) over the degree sweep's Chmutov surfaces T_n, n = 2-20, and the
-hand-written baselines beside their generated programs, at 1024^2 and 2048^2, with the
+hand-written baselines beside their generated programs (Yuksel's solver beside exact at
+T_4, T_10, T_16 and T_20), at 1024^2 and 2048^2, with the
 device named. Every figure on docs/RESULTS.md is llvmpipe's, a CPU's; this is how to
 check them on a GPU (`make gpu-bench`).
 
@@ -22,13 +23,14 @@ import sys
 
 from eval_forms import _degrees, float32_holds, sweep_equations
 
-from implc.baseline import BASELINES, open_baseline_runner
+from implc.baseline import BASELINES, SOLVERS, open_baseline_runner, open_solver_runner
 from implc.bench import time_interleaved
 from implc.loaders import load_surface
 from implc.methods import get_method
 from implc.render.run import open_runner
 
 METHODS = ("exact", "taylor", "hessian", "interval")
+SOLVER_DEGREES = (4, 10, 16, 20)  # Chmutov T_n for the hand-written solvers (SOLVERS)
 CPU_RENDERERS = ("llvmpipe", "lavapipe", "softpipe", "swiftshader")
 
 
@@ -87,6 +89,15 @@ def baselines(size: int, frames: int) -> None:
              open_baseline_runner(key, method, constants, surface, size, size)], frames)
         print(f"| {key} | {method} | {generated:.2f} | {written:.2f} | "
               f"{written / generated:.2f} |", flush=True)
+    for name, solver in SOLVERS.items():  # for any polynomial: Chmutov T_n (float32)
+        constants = get_method(solver.method).defaults
+        for degree in SOLVER_DEGREES:
+            surface = load_surface(equation=sweep_equations(degree)["chmutov"])
+            generated, written = median_ms(
+                [open_runner(surface, "gl", solver.method, constants, size, size),
+                 open_solver_runner(name, surface, constants, size, size)], frames)
+            print(f"| Chmutov T{degree} | {solver.method} ({name}) | {generated:.2f} | "
+                  f"{written:.2f} | {written / generated:.2f} |", flush=True)
 
 
 def main() -> None:
