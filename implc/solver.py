@@ -98,6 +98,18 @@ NEXT_FLOOR = 4
 FIRST_REACH = 8
 FIRST_HALVINGS = 3
 
+# Where the Newton after the walk reads Estrin's value of the chord's coefficients (from
+# ROBUST_NEWTON_BELOW) in float32, this many Newton steps on F's robust value (S at the
+# point) follow it, inside the root node. The chord's coefficients are a Taylor expansion
+# about the chord's middle, computed from S's monomials: in float32 their rounding is a
+# share of terms far larger than F near its root (Chmutov's T_12 written in monomials, a
+# clip radius of 1.5), and Estrin's root lands up to 1e-2 from the root. Measured at 256^2
+# against the certified reference (scripts/float32_diagnosis.py): S at the point alone in
+# float32, everything else in double, 2 bad pixels on T_12; the coefficients alone in
+# float32, 31; the float32 program 33, with one step on S 5, with two 5. In double the
+# coefficients hold the root and nothing follows Estrin's Newton (programs unchanged).
+POLISH_STEPS = 1
+
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
@@ -147,6 +159,9 @@ class Solver:
     # bernstein: FIRST_REACH printed, FIRST_HALVINGS
     first_reach: str = ""
     first_halvings: int = 0
+    # bernstein, Newton on Estrin's value in float32: the Newton steps on F's robust value
+    # after it (POLISH_STEPS; 0: none)
+    polish: int = 0
 
 
 @dataclass(frozen=True)
@@ -267,7 +282,9 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                               for level, pairs in descent_levels(n)),
                         printer.float_literal(NEXT_REACH / n),
                         printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS,
-                        printer.float_literal(FIRST_REACH), FIRST_HALVINGS)
+                        printer.float_literal(FIRST_REACH), FIRST_HALVINGS,
+                        POLISH_STEPS if not robust_newton and printer.precision == "float"
+                        else 0)
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
