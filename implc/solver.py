@@ -11,6 +11,7 @@ from typing import ClassVar
 
 import sympy
 
+from .chebyshev import chebyshev_program
 from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
@@ -226,6 +227,10 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     that place the critical points are bound by their chains: 7 % a frame on the quartics,
     29 % at degree 12), F itself too, with the rounding bound ROUND_ERR states."""
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
+    if printer.precision == "float" and polynomial_degree(expr) >= ROBUST_NEWTON_BELOW:
+        chebyshev = chebyshev_program(expr)  # S where float32 cannot hold its monomials
+        if chebyshev is not None:
+            programs["S"] = chebyshev
     functions = [point_function(name, program, printer, carried)
                  for name, program in programs.items()]
     coefficients = coefficient_program(expr, printer.precision)
