@@ -35,10 +35,11 @@ from .extent import locate_surface, sign_changes
 from .optimize import Program, count_ops
 from .symbols import POINT
 
-# The monomials' magnitude at the box's far corner over the Chebyshev coefficients' sum
-# from which S at the point is printed by Clenshaw's recurrence (Chmutov's T_12: 6e4
-# against 17; x^n + y^n + z^n - 1: about 1)
+# How many times farther the monomials must move the sampled surface than Chebyshev's
+# basis (90th percentiles) for S at the point to be printed by Clenshaw's recurrence
 GAIN = 16.0
+# the surface's sampled points the box is chosen on, at most (every k-th sign change)
+BOX_POINTS = 1500
 # the box's centre and half widths are rounded outwards to multiples of 2^-BOX_BITS of
 # the largest half width
 BOX_BITS = 6
@@ -56,40 +57,124 @@ def _program(expr: sympy.Expr) -> Program | None:
     terms = expanded_terms(expr)
     if not terms or not all(c.is_number for c in terms.values()):
         return None
-    box = surface_box(expr)
+    box = surface_box(expr, terms)
     if box is None:
         return None
     coefficients = tensor_coefficients({m: sympy.nsimplify(c) if c.is_Float else c
                                         for m, c in terms.items()}, box)
-    corner = [abs(c) + h for c, h in box]
-    monomials = sum(abs(float(c)) * math.prod(v ** e for v, e in zip(corner, m, strict=True))
-                    for m, c in terms.items())
-    total = sum(abs(float(b)) for b in coefficients.values())
-    if monomials < GAIN * total:
-        return None
     return _clenshaw_program(coefficients, box)
 
 
-def surface_box(expr: sympy.Expr) -> tuple[tuple[sympy.Rational, sympy.Rational], ...] | None:
-    """(centre, half width) per axis of the box that holds S's sampled sign changes, a grid
-    cell wider each side, as dyadic rationals rounded outwards; None: no surface found."""
+def surface_box(expr: sympy.Expr, terms: dict | None = None) -> Box | None:
+    """(centre, half width) per axis, dyadic, of the box whose Chebyshev basis moves S's
+    sampled surface least in float32, or None: no surface found, or the monomials move it
+    less than GAIN times as far. The candidates are the boxes holding a share
+    (QUANTILES) of the sign changes about their centre, a grid cell wider each side: a
+    bounded surface's whole box, and for one that leaves the sampled cube (odd Chmutov
+    surfaces, sheets to infinity) the core where most of it lies. The measure is
+    conditioning.py's, in each basis: the terms' magnitudes at each point over |grad S|,
+    its 90th percentile over the points."""
+    terms = expanded_terms(expr) if terms is None else terms
     extent = locate_surface(expr)
     if extent is None:
         return None
-    points, spacing, _ = sign_changes(expr, np.asarray(extent.center, dtype=np.float64),
-                                      extent.radius)
+    center = np.asarray(extent.center, dtype=np.float64)
+    points, spacing, _ = sign_changes(expr, center, extent.radius)
+    if len(points) < 8:
+        return None
+    points = points[::max(1, len(points) // BOX_POINTS)]
+    monomials = np.array(list(terms), dtype=np.int64)
+    values = np.array([float(c) for c in terms.values()])
+    slope = _slope(monomials, values, points)
+    keep = slope > 0
+    points, slope = points[keep], slope[keep]
     if not len(points):
         return None
-    low, high = points.min(axis=0) - spacing, points.max(axis=0) + spacing
-    unit = 2.0 ** (math.floor(math.log2(max(high - low))) - BOX_BITS)
+    magnitude = np.abs(values) @ np.prod(np.abs(points[:, None, :]) ** monomials[None], axis=2).T
+    best = None
+    for q in QUANTILES:
+        half = np.quantile(np.abs(points - center), q, axis=0) + spacing
+        box = _dyadic(center, half)
+        b = _float_coefficients(monomials, values, box)
+        moved = float(np.quantile(_chebyshev_magnitude(b, points, box) / slope, 0.9))
+        if best is None or moved < best[0]:
+            best = (moved, box)
+    if best is None or float(np.quantile(magnitude / slope, 0.9)) < GAIN * best[0]:
+        return None
+    return best[1]
+
+
+# the shares of the sign changes the candidate boxes hold (see surface_box)
+QUANTILES = (0.5, 0.75, 0.9, 1.0)
+
+
+Box = tuple[tuple[sympy.Rational, sympy.Rational], ...]  # (centre, half width) per axis
+
+
+def _dyadic(center: np.ndarray, half: np.ndarray) -> Box:
+    """The box [center - half, center + half] rounded outwards to multiples of
+    2^-BOX_BITS of its widest half width, exactly (dyadic rationals)."""
+    unit = 2.0 ** (math.floor(math.log2(float(max(half)))) - BOX_BITS)
     box = []
-    for lo, hi in zip(low, high, strict=True):
-        lo_q, hi_q = math.floor(lo / unit), math.ceil(hi / unit)
+    for c, h in zip(center, half, strict=True):
+        lo_q, hi_q = math.floor((c - h) / unit), math.ceil((c + h) / unit)
         if (hi_q - lo_q) % 2:
             hi_q += 1
         box.append((sympy.Rational((lo_q + hi_q) // 2) * sympy.Rational(unit),
                     sympy.Rational(hi_q - lo_q, 2) * sympy.Rational(unit)))
     return tuple(box)
+
+
+def _slope(monomials: np.ndarray, values: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """|grad S| at the points, from S's monomials."""
+    grad = []
+    for axis in range(3):
+        e = monomials[:, axis]
+        lowered = monomials.copy()
+        lowered[:, axis] = np.maximum(e - 1, 0)
+        powers = np.prod(points[:, None, :] ** lowered[None], axis=2)
+        grad.append(powers @ (values * e))
+    return np.sqrt(sum(g * g for g in grad))
+
+
+def _chebyshev_table(t: np.ndarray, top: int) -> np.ndarray:
+    """|T_k(t)| for k = 0..top at each t: (len(t), top + 1)."""
+    table = np.ones((len(t), top + 1))
+    if top:
+        table[:, 1] = t
+    for k in range(2, top + 1):
+        table[:, k] = 2 * t * table[:, k - 1] - table[:, k - 2]
+    return np.abs(table)
+
+
+def _float_coefficients(monomials: np.ndarray, values: np.ndarray, box) -> np.ndarray:
+    """b_lmn in float64 (a dense array), for choosing the box."""
+    from numpy.polynomial import chebyshev, polynomial
+
+    top = int(monomials.max())
+    per_axis = []
+    for c, h in box:
+        rows = np.zeros((top + 1, top + 1))
+        for e in sorted(set(monomials.ravel().tolist())):
+            power = polynomial.polypow([float(c), float(h)], e)
+            cheb = chebyshev.poly2cheb(power)
+            rows[e, :len(cheb)] = cheb
+        per_axis.append(rows)
+    b = np.zeros((top + 1,) * 3)
+    for (i, j, k), a in zip(monomials, values, strict=True):
+        b += a * np.einsum("l,m,n->lmn", per_axis[0][i], per_axis[1][j], per_axis[2][k])
+    return b
+
+
+def _chebyshev_magnitude(b: np.ndarray, points: np.ndarray, box) -> np.ndarray:
+    """sum |b_lmn| |T_l(X)| |T_m(Y)| |T_n(Z)| at each point: Clenshaw's rounding's unit."""
+    top = b.shape[0] - 1
+    tables = [_chebyshev_table((points[:, a] - float(c)) / float(h), top)
+              for a, (c, h) in enumerate(box)]
+    size = b.shape[0]
+    inner = np.abs(b).reshape(size * size, size) @ tables[2].T  # over n: (l m, points)
+    inner = (inner.reshape(size, size, -1) * tables[1].T[None]).sum(axis=1)  # over m
+    return (inner * tables[0].T).sum(axis=0)
 
 
 def tensor_coefficients(terms: dict, box) -> dict[tuple[int, int, int], sympy.Rational]:
