@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import sympy
 
 from .conditioning import (
+    RAY_TO_PIXELS,
     RAY_WARN_SHARE,
     WARN_SHARE,
     Conditioning,
@@ -54,7 +55,8 @@ class Float32Report:
             return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
                     f"moves the first root by more than {T_TOL:g} on "
                     f"{100 * self.ray.far:.2f} % of the view's pixel rays (expect about "
-                    "that share of wrong pixels)")
+                    f"1/{RAY_TO_PIXELS} of that share of wrong pixels: exact's walk reads "
+                    "them)")
         if self.point_warns:
             return (f"float32 cannot hold this surface: a rounding of S moves it by more "
                     f"than {T_TOL:g} at {100 * self.point.far:.1f} % of its sampled points "
