@@ -222,7 +222,9 @@ def _chebyshev_of(power_coefficients: list) -> list:
 
 def _clenshaw_program(b: dict, box) -> Program:
     """Nested Clenshaw: for each (l, m) the sum over n in Z, then over m in Y, then over l
-    in X; every step named (k0, k1, ...), the variables' Chebyshev arguments first."""
+    in X; every step named (k0, k1, ...). A series of even terms alone (a surface
+    symmetric in that variable: Chmutov's T_n of even n) takes half the steps in T_2 of
+    its argument."""
     assignments: list[tuple[sympy.Symbol, sympy.Expr]] = []
 
     def named(value: sympy.Expr) -> sympy.Expr:
@@ -232,19 +234,34 @@ def _clenshaw_program(b: dict, box) -> Program:
         assignments.append((symbol, value))
         return symbol
 
-    args = [named((v - _number(c)) * _number(1 / h)) for v, (c, h) in zip(POINT, box, strict=True)]
-    twice = [named(2 * a) for a in args]
+    # the argument of each axis at each level: t, then T_2(t) = 2t^2 - 1, T_2(T_2(t)), ...
+    levels = [[named((v - _number(c)) * _number(1 / h))]
+              for v, (c, h) in zip(POINT, box, strict=True)]
+    twice: dict[tuple[int, int], sympy.Expr] = {}
 
-    def clenshaw(values: dict[int, sympy.Expr], axis: int) -> sympy.Expr:
-        """sum values[k] T_k(arg) by Clenshaw's recurrence."""
+    def argument(axis: int, level: int) -> tuple[sympy.Expr, sympy.Expr]:
+        """The axis's argument at `level` and twice it."""
+        while len(levels[axis]) <= level:
+            t = levels[axis][-1]
+            levels[axis].append(named(2 * t * t - 1))
+        if (axis, level) not in twice:
+            twice[axis, level] = named(2 * levels[axis][level])
+        return levels[axis][level], twice[axis, level]
+
+    def clenshaw(values: dict[int, sympy.Expr], axis: int, level: int = 0) -> sympy.Expr:
+        """sum values[k] T_k(arg) by Clenshaw's recurrence; where every k is even, in
+        T_2(arg), with half the steps (T_2j(t) = T_j(T_2(t)))."""
         top = max(values)
         if top == 0:
             return values[0]
+        if all(k % 2 == 0 for k in values):
+            return clenshaw({k // 2: v for k, v in values.items()}, axis, level + 1)
+        t, t2 = argument(axis, level)
         zero = sympy.S.Zero
         b1, b2 = zero, zero
         for k in range(top, 0, -1):
-            b1, b2 = named(values.get(k, zero) + twice[axis] * b1 - b2), b1
-        return named(values.get(0, zero) + args[axis] * b1 - b2)
+            b1, b2 = named(values.get(k, zero) + t2 * b1 - b2), b1
+        return named(values.get(0, zero) + t * b1 - b2)
 
     rows: dict[int, dict[int, dict[int, sympy.Expr]]] = {}
     for (i, j, k), value in b.items():
