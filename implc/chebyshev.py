@@ -33,7 +33,7 @@ import sympy
 from .derive import expanded_terms
 from .extent import locate_surface, sign_changes
 from .optimize import Program, count_ops
-from .symbols import POINT
+from .symbols import DIRECTION, POINT
 
 # How many times farther the monomials must move the sampled surface than Chebyshev's
 # basis (90th percentiles) for S at the point to be printed by Clenshaw's recurrence
@@ -220,12 +220,14 @@ def _chebyshev_of(power_coefficients: list) -> list:
     return out
 
 
-def _clenshaw_program(b: dict, box) -> Program:
+def _clenshaw_program(b: dict, box, n: int | None = None) -> Program:
     """Nested Clenshaw: for each (l, m) the sum over n in Z, then over m in Y, then over l
     in X; every step named (k0, k1, ...). A series of even terms alone (a surface
     symmetric in that variable: Chmutov's T_n of even n) takes half the steps in T_2 of
-    its argument."""
+    its argument. With `n`, every value is a power series in s truncated at degree n (a
+    list of coefficients, lowest first) and the outputs are F's c_0..c_n."""
     assignments: list[tuple[sympy.Symbol, sympy.Expr]] = []
+    zero = sympy.S.Zero
 
     def named(value: sympy.Expr) -> sympy.Expr:
         if value.is_Atom:
@@ -234,21 +236,39 @@ def _clenshaw_program(b: dict, box) -> Program:
         assignments.append((symbol, value))
         return symbol
 
-    # the argument of each axis at each level: t, then T_2(t) = 2t^2 - 1, T_2(T_2(t)), ...
-    levels = [[named((v - _number(c)) * _number(1 / h))]
-              for v, (c, h) in zip(POINT, box, strict=True)]
-    twice: dict[tuple[int, int], sympy.Expr] = {}
+    def series(value) -> list:
+        return value if isinstance(value, list) else [value]
 
-    def argument(axis: int, level: int) -> tuple[sympy.Expr, sympy.Expr]:
+    def add(*parts) -> list:  # sums of (factor, series)
+        size = max(len(series(s)) for _, s in parts)
+        return [named(sympy.Add(*(f * series(s)[i] for f, s in parts if i < len(series(s)))))
+                for i in range(size)]
+
+    def times(a, c) -> list:  # a * c, truncated at degree n
+        a, c = series(a), series(c)
+        size = min(len(a) + len(c) - 1, (n if n is not None else 0) + 1)
+        return [named(sympy.Add(*(a[i] * c[k - i] for i in range(len(a))
+                                  if 0 <= k - i < len(c))))
+                for k in range(size)]
+
+    # the argument of each axis at each level: t, then T_2(t) = 2t^2 - 1, T_2(T_2(t)), ...
+    levels = []
+    for axis, (c, h) in enumerate(box):
+        t0 = named((POINT[axis] - _number(c)) * _number(1 / h))
+        levels.append([[t0] if n is None else [t0, named(DIRECTION[axis] * _number(1 / h))]])
+    twice: dict[tuple[int, int], list] = {}
+
+    def argument(axis: int, level: int) -> tuple[list, list]:
         """The axis's argument at `level` and twice it."""
         while len(levels[axis]) <= level:
             t = levels[axis][-1]
-            levels[axis].append(named(2 * t * t - 1))
+            square = times(t, t)
+            levels[axis].append(add((2, square), (-1, [sympy.S.One])))
         if (axis, level) not in twice:
-            twice[axis, level] = named(2 * levels[axis][level])
+            twice[axis, level] = add((2, levels[axis][level]))
         return levels[axis][level], twice[axis, level]
 
-    def clenshaw(values: dict[int, sympy.Expr], axis: int, level: int = 0) -> sympy.Expr:
+    def clenshaw(values: dict[int, object], axis: int, level: int = 0):
         """sum values[k] T_k(arg) by Clenshaw's recurrence; where every k is even, in
         T_2(arg), with half the steps (T_2j(t) = T_j(T_2(t)))."""
         top = max(values)
@@ -257,20 +277,47 @@ def _clenshaw_program(b: dict, box) -> Program:
         if all(k % 2 == 0 for k in values):
             return clenshaw({k // 2: v for k, v in values.items()}, axis, level + 1)
         t, t2 = argument(axis, level)
-        zero = sympy.S.Zero
-        b1, b2 = zero, zero
+        b1: object = [zero]
+        b2: object = [zero]
         for k in range(top, 0, -1):
-            b1, b2 = named(values.get(k, zero) + t2 * b1 - b2), b1
-        return named(values.get(0, zero) + t * b1 - b2)
+            b1, b2 = add((1, values.get(k, zero)), (1, times(t2, b1)), (-1, b2)), b1
+        return add((1, values.get(0, zero)), (1, times(t, b1)), (-1, b2))
 
     rows: dict[int, dict[int, dict[int, sympy.Expr]]] = {}
     for (i, j, k), value in b.items():
         rows.setdefault(i, {}).setdefault(j, {})[k] = _number(value)
     outer = {i: clenshaw({j: clenshaw(zs, 2) for j, zs in sorted(ys.items())}, 1)
              for i, ys in sorted(rows.items())}
-    value = clenshaw(outer, 0)
+    value = series(clenshaw(outer, 0))
     ops = sum(count_ops(v) for _, v in assignments)
-    return Program(POINT, tuple(assignments), (value,), ops, ops)
+    if n is None:
+        return Program(POINT, tuple(assignments), (value[0],), ops, ops)
+    outputs = tuple(value[:n + 1]) + (zero,) * (n + 1 - len(value))
+    return Program(POINT + DIRECTION, tuple(assignments), outputs, ops, ops)
+
+
+def chebyshev_ray_program(expr: sympy.Expr) -> Program | None:
+    """The ray polynomial's coefficients c_0..c_n of F(s) = S(o + s d) from S in
+    Chebyshev's basis of its box (None where chebyshev_program is None): the nested
+    Clenshaw recurrences of _clenshaw_program on truncated power series in s, each
+    variable's argument X(s) = (o - c)/h + s d/h. Their terms are about the coefficients'
+    own size, where S's monomials' are up to (1 + sqrt 2)^n larger: computed in float32
+    here, exact's walk on T_16 (256^2, against the certified reference) has 15 bad
+    pixels, as with coefficients computed in double and rounded, against 55 from the
+    monomials (scripts/float32_diagnosis.py)."""
+    return _ray_program(expr)
+
+
+@lru_cache(maxsize=16)
+def _ray_program(expr: sympy.Expr) -> Program | None:
+    if _program(expr) is None:
+        return None
+    terms = expanded_terms(expr)
+    box = surface_box(expr, terms)
+    coefficients = tensor_coefficients({m: sympy.nsimplify(c) if c.is_Float else c
+                                        for m, c in terms.items()}, box)
+    n = max(sum(m) for m in terms)
+    return _clenshaw_program(coefficients, box, n)
 
 
 def _number(value: sympy.Rational) -> sympy.Expr:

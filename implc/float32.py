@@ -23,10 +23,9 @@ from .conditioning import (
 )
 from .derive import polynomial_degree
 from .options import EXACT_MAX_DEGREE, T_TOL
-from .raypoly import coefficient_program
 from .scaling import scale_exponent, scaled
 from .scene import View
-from .solver import ROBUST_NEWTON_BELOW
+from .solver import ROBUST_NEWTON_BELOW, exact_coefficients
 from .surface import Surface
 from .symbols import POINT
 
@@ -76,7 +75,7 @@ def float32_report(expr: sympy.Expr, view: View, degree: int,
     expr = scaled(expr, scale)
     if gradient is not None:
         gradient = tuple(scaled(g, scale) for g in gradient)
-    rays = (ray_conditioning(coefficient_program(expr, "float"), view)
+    rays = (ray_conditioning(exact_coefficients(expr, "float"), view)
             if ray and ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
     if not point:
         return Float32Report(None, rays)

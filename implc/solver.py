@@ -11,7 +11,7 @@ from typing import ClassVar
 
 import sympy
 
-from .chebyshev import chebyshev_program
+from .chebyshev import chebyshev_program, chebyshev_ray_program
 from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
@@ -221,6 +221,22 @@ def _value_function(name: str, n: int, printer, prefix: str,
         (printer.print_select(certain, "h", at_point),))
 
 
+def _in_chebyshev(expr: sympy.Expr, precision: str) -> bool:
+    """Whether exact's program evaluates S, and computes the ray's coefficients, from S in
+    Chebyshev's basis of its box (implc/chebyshev.py): in float32, from
+    ROBUST_NEWTON_BELOW (where its Newton and walk read them), where that basis holds S
+    better than its monomials."""
+    return (precision == "float" and (polynomial_degree(expr) or 0) >= ROBUST_NEWTON_BELOW
+            and chebyshev_program(expr) is not None)
+
+
+def exact_coefficients(expr: sympy.Expr, precision: str):
+    """The program of the ray's coefficients exact's shader computes in `precision`."""
+    if _in_chebyshev(expr, precision):
+        return chebyshev_ray_program(expr)
+    return coefficient_program(expr, precision)
+
+
 def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                   max_derived: int, carried: tuple[tuple[str, str], ...]) -> Solving:
     """The pieces of templates/solver.j2: S and grad at the point (shading, residual),
@@ -229,13 +245,11 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     that place the critical points are bound by their chains: 7 % a frame on the quartics,
     29 % at degree 12), F itself too, with the rounding bound ROUND_ERR states."""
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
-    if printer.precision == "float" and polynomial_degree(expr) >= ROBUST_NEWTON_BELOW:
-        chebyshev = chebyshev_program(expr)  # S where float32 cannot hold its monomials
-        if chebyshev is not None:
-            programs["S"] = chebyshev
+    if _in_chebyshev(expr, printer.precision):
+        programs["S"] = chebyshev_program(expr)  # where float32 cannot hold S's monomials
     functions = [point_function(name, program, printer, carried)
                  for name, program in programs.items()]
-    coefficients = coefficient_program(expr, printer.precision)
+    coefficients = exact_coefficients(expr, printer.precision)
     n = len(coefficients.outputs) - 1
     u = sym("u")
     bernstein = n >= BERNSTEIN_FROM
