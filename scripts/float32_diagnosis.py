@@ -3,6 +3,8 @@ one part computed in the other precision, rendered on gl (llvmpipe, double throu
 GL_ARB_gpu_shader_fp64) and counted against the certified float64 reference.
 
     python scripts/float32_diagnosis.py --size 256 12 16 20
+    python scripts/float32_diagnosis.py --size 256 --backends gl,wgpu,cl,hlsl-spirv 14 16 20
+        exact in float32 as compiled, on each backend, instead of the variants
 
 Variants (docs/journal/2026-12-05-float32.md has the numbers):
 - float, double: the programs as compiled (`-t glsl`, `--precision double`);
@@ -102,12 +104,37 @@ def variants(n: int) -> tuple[object, dict[str, str]]:
     }
 
 
+def backends(degrees: list[int], size: int, names: list[str]) -> None:
+    """exact as compiled (float32 on each float32 backend) against the reference."""
+    from implc.render.run import open_runner
+
+    print("| degree | backend | false / missed / wrong | bad pixels |")
+    print("|---|---|---|---|")
+    for n in degrees:
+        surface = load_surface(equation=sweep_equations(n)["chmutov"])
+        reference = render(surface, "reference", "", get_method("taylor").defaults, size, size)
+        for backend in names:
+            runner = open_runner(surface, backend, "exact", get_method("exact").defaults,
+                                 size, size)
+            try:
+                m = compare(runner.frame(), reference)
+            finally:
+                runner.release()
+            bad = m["false_hits"] + m["missed_hits"] + m["wrong_root"]
+            print(f"| T_{n} | {backend} | {m['false_hits']} / {m['missed_hits']} / "
+                  f"{m['wrong_root']} | {bad} ({100 * bad / m['pixels']:.4f} %) |", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("degrees", nargs="+", type=int)
     ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--backends", help="comma-separated: exact as compiled on each")
     args = ap.parse_args()
+    if args.backends:
+        backends(args.degrees, args.size, args.backends.split(","))
+        return
     vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
     print("| degree | variant | false / missed / wrong | bad pixels |")
     print("|---|---|---|---|")
