@@ -15,7 +15,7 @@ from .chebyshev import chebyshev_program, chebyshev_ray_program
 from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
-from .optimize import count_ops
+from .optimize import Program, count_ops
 from .options import EXACT_MAX_DEGREE, UNIT_ROUNDOFF
 from .pieces import (
     Marcher,
@@ -230,11 +230,10 @@ def _in_chebyshev(expr: sympy.Expr, precision: str) -> bool:
             and chebyshev_program(expr) is not None)
 
 
-def exact_coefficients(expr: sympy.Expr, precision: str):
+def exact_coefficients(expr: sympy.Expr, precision: str) -> Program:
     """The program of the ray's coefficients exact's shader computes in `precision`."""
-    if _in_chebyshev(expr, precision):
-        return chebyshev_ray_program(expr)
-    return coefficient_program(expr, precision)
+    chebyshev = chebyshev_ray_program(expr) if _in_chebyshev(expr, precision) else None
+    return chebyshev if chebyshev is not None else coefficient_program(expr, precision)
 
 
 def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
@@ -245,8 +244,9 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     that place the critical points are bound by their chains: 7 % a frame on the quartics,
     29 % at degree 12), F itself too, with the rounding bound ROUND_ERR states."""
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
-    if _in_chebyshev(expr, printer.precision):
-        programs["S"] = chebyshev_program(expr)  # where float32 cannot hold S's monomials
+    chebyshev = chebyshev_program(expr) if _in_chebyshev(expr, printer.precision) else None
+    if chebyshev is not None:  # where float32 cannot hold S's monomials
+        programs["S"] = chebyshev
     functions = [point_function(name, program, printer, carried)
                  for name, program in programs.items()]
     coefficients = exact_coefficients(expr, printer.precision)
