@@ -268,14 +268,33 @@ def _clenshaw_program(b: dict, box, n: int | None = None) -> Program:
             twice[axis, level] = add((2, levels[axis][level]))
         return levels[axis][level], twice[axis, level]
 
+    def third_kind(values: dict[int, object], axis: int, level: int):
+        """sum values[j] V_j(u) (V: Chebyshev's polynomials of the third kind, V_0 = 1,
+        V_1 = 2u - 1, the same recurrence as T's), u the argument at `level`."""
+        if max(values) == 0:
+            return values[0]
+        _, u2 = argument(axis, level)
+        b1: object = [zero]
+        b2: object = [zero]
+        for k in range(max(values), 0, -1):
+            b1, b2 = add((1, values.get(k, zero)), (1, times(u2, b1)), (-1, b2)), b1
+        return add((1, values.get(0, zero)), (-1, b2),
+                   (1, times(add((1, u2), (-1, [sympy.S.One])), b1)))
+
     def clenshaw(values: dict[int, object], axis: int, level: int = 0):
         """sum values[k] T_k(arg) by Clenshaw's recurrence; where every k is even, in
-        T_2(arg), with half the steps (T_2j(t) = T_j(T_2(t)))."""
+        T_2(arg), with half the steps (T_2j(t) = T_j(T_2(t))); where every k is odd (but
+        for a constant), in T_2(arg) too, by T_(2j+1)(t) = t V_j(T_2(t))."""
         top = max(values)
         if top == 0:
             return values[0]
         if all(k % 2 == 0 for k in values):
             return clenshaw({k // 2: v for k, v in values.items()}, axis, level + 1)
+        if all(k % 2 == 1 for k in values if k):
+            t, _ = argument(axis, level)
+            odd = times(t, third_kind({(k - 1) // 2: v for k, v in values.items() if k},
+                                      axis, level + 1))
+            return add((1, odd), (1, values[0])) if 0 in values else odd
         t, t2 = argument(axis, level)
         b1: object = [zero]
         b2: object = [zero]
