@@ -11,7 +11,6 @@ from typing import ClassVar
 
 import sympy
 
-from .chebyshev import chebyshev_program, chebyshev_ray_program
 from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
@@ -221,18 +220,27 @@ def _value_function(name: str, n: int, printer, prefix: str,
         (printer.print_select(certain, "h", at_point),))
 
 
-def _in_chebyshev(expr: sympy.Expr, precision: str) -> bool:
-    """Whether exact's program evaluates S, and computes the ray's coefficients, from S in
-    Chebyshev's basis of its box (implc/chebyshev.py): in float32, from
+def _chebyshev(expr: sympy.Expr, precision: str, ray: bool) -> Program | None:
+    """S (or, with `ray`, the ray's coefficients) from S in Chebyshev's basis of its box
+    (implc/chebyshev.py), where exact's program takes them: in float32, from
     ROBUST_NEWTON_BELOW (where its Newton and walk read them), where that basis holds S
-    better than its monomials."""
-    return (precision == "float" and (polynomial_degree(expr) or 0) >= ROBUST_NEWTON_BELOW
-            and chebyshev_program(expr) is not None)
+    better than its monomials; else None. The box is found by sampling S with numpy:
+    where numpy cannot load (the compile path needs only sympy and jinja2, issue 43), S's
+    monomials are kept, and such a program differs from the one compiled with numpy."""
+    if precision != "float" or (polynomial_degree(expr) or 0) < ROBUST_NEWTON_BELOW:
+        return None
+    try:
+        from .chebyshev import chebyshev_program, chebyshev_ray_program
+    except ImportError:  # numpy missing
+        return None
+    if chebyshev_program(expr) is None:
+        return None
+    return chebyshev_ray_program(expr) if ray else chebyshev_program(expr)
 
 
 def exact_coefficients(expr: sympy.Expr, precision: str) -> Program:
     """The program of the ray's coefficients exact's shader computes in `precision`."""
-    chebyshev = chebyshev_ray_program(expr) if _in_chebyshev(expr, precision) else None
+    chebyshev = _chebyshev(expr, precision, ray=True)
     return chebyshev if chebyshev is not None else coefficient_program(expr, precision)
 
 
@@ -244,7 +252,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     that place the critical points are bound by their chains: 7 % a frame on the quartics,
     29 % at degree 12), F itself too, with the rounding bound ROUND_ERR states."""
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
-    chebyshev = chebyshev_program(expr) if _in_chebyshev(expr, printer.precision) else None
+    chebyshev = _chebyshev(expr, printer.precision, ray=False)
     if chebyshev is not None:  # where float32 cannot hold S's monomials
         programs["S"] = chebyshev
     functions = [point_function(name, program, printer, carried)
