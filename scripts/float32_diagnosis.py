@@ -5,6 +5,10 @@ GL_ARB_gpu_shader_fp64) and counted against the certified float64 reference.
     python scripts/float32_diagnosis.py --size 256 12 16 20
     python scripts/float32_diagnosis.py --size 256 --backends gl,wgpu,cl,hlsl-spirv 14 16 20
         exact in float32 as compiled, on each backend, instead of the variants
+    python scripts/float32_diagnosis.py --size 512 --time 5 --before old/ 7-20
+        exact against taylor, both in float32 on gl, in turns (one warm-up frame, medians
+        of 5); with --before, also the programs old/T<n>.frag (exact's float32 GLSL
+        program compiled by an earlier commit)
 
 Variants (docs/journal/2026-12-05-float32.md has the numbers):
 - float, double: the programs as compiled (`-t glsl`, `--precision double`);
@@ -125,13 +129,56 @@ def backends(degrees: list[int], size: int, names: list[str]) -> None:
                   f"{m['wrong_root']} | {bad} ({100 * bad / m['pixels']:.4f} %) |", flush=True)
 
 
+def _degrees(text: str) -> list[int]:
+    low, _, high = text.partition("-")
+    return list(range(int(low), int(high or low) + 1))
+
+
+def timing(degrees: list[int], size: int, frames: int, before: str | None) -> None:
+    """exact (and the --before programs) against taylor, float32 on gl, in turns."""
+    import statistics
+
+    from implc.bench import time_interleaved
+    from implc.marcher import choose_form
+    from implc.render.run import open_runner
+
+    vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
+    print("| degree | exact ms | taylor ms | exact / taylor | before ms | before / taylor |")
+    print("|---|---|---|---|---|---|")
+    for n in degrees:
+        surface = load_surface(equation=sweep_equations(n)["chmutov"])
+        taylor = get_method("taylor").constants(
+            evaluation=choose_form(get_method("taylor"), surface.expr))
+        runners = [open_runner(surface, "gl", "exact", get_method("exact").defaults,
+                               size, size),
+                   open_runner(surface, "gl", "taylor", taylor, size, size)]
+        if before:
+            text = (Path(before) / f"T{n}.frag").read_text()
+            runners.append(GlRunner(text, vertex, surface.view, size, size))
+        try:
+            seconds, _, _ = time_interleaved(runners, frames)
+        finally:
+            for runner in runners:
+                runner.release()
+        ms = [1000 * statistics.median(s) for s in seconds]
+        old = f"{ms[2]:.1f} | {ms[2] / ms[1]:.2f}" if before else "| "
+        print(f"| T_{n} | {ms[0]:.1f} | {ms[1]:.1f} | {ms[0] / ms[1]:.2f} | {old} |",
+              flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("degrees", nargs="+", type=int)
+    ap.add_argument("degrees", nargs="+", help="degrees, or ranges a-b")
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--backends", help="comma-separated: exact as compiled on each")
+    ap.add_argument("--time", type=int, metavar="FRAMES", help="time exact against taylor")
+    ap.add_argument("--before", help="a directory of T<n>.frag programs to time beside")
     args = ap.parse_args()
+    args.degrees = [n for part in args.degrees for n in _degrees(part)]
+    if args.time:
+        timing(args.degrees, args.size, args.time, args.before)
+        return
     if args.backends:
         backends(args.degrees, args.size, args.backends.split(","))
         return
