@@ -99,17 +99,18 @@ FIRST_REACH = 8
 FIRST_HALVINGS = 3
 
 # Where the Newton after the walk reads Estrin's value of the chord's coefficients (from
-# ROBUST_NEWTON_BELOW) in float32, this many Newton steps on F's robust value (S at the
+# ROBUST_NEWTON_BELOW) in float32 and S stays in monomials (no gain from Chebyshev's basis,
+# --params uniform, or no numpy), this many Newton steps on F's robust value (S at the
 # point) follow it, inside the root node. The chord's coefficients are a Taylor expansion
-# about the chord's middle, computed from S's monomials: in float32 their rounding is a
+# about the chord's middle, computed from S's monomials: in float32 their rounding can be a
 # share of terms far larger than F near its root (Chmutov's T_12 written in monomials, a
 # clip radius of 1.5), and Estrin's root lands up to 1e-2 from the root. Measured at 256^2
-# against the certified reference (scripts/float32_diagnosis.py): S at the point alone in
-# float32, everything else in double, 2 bad pixels on T_12; the coefficients alone in
-# float32, 31; the float32 program 33, with one step on S 5, with two 5; with S in
-# Chebyshev's basis (implc/chebyshev.py) on T_16, one step 101 bad pixels, two 55, three 48,
-# on T_13 at 128^2 one 3, two 2. In double the coefficients hold the root and nothing
-# follows Estrin's Newton (programs unchanged).
+# against the certified reference (scripts/float32_diagnosis.py): on T_12 with S in
+# monomials, the float32 program 33 bad pixels, with one step on S 5, with two 5 (S at the
+# point alone in float32, everything else in double: 2). Where S is in Chebyshev's basis
+# the Newton reads S throughout instead (lower_solver). On x^12 and x^20 sums and Barth's
+# decic the counts are unchanged (0 / 0 / 0, 0 / 0 / 0, 0 / 2 / 0). In double the
+# coefficients hold the root and nothing follows Estrin's Newton (programs unchanged).
 POLISH_STEPS = 2
 
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
