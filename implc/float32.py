@@ -53,9 +53,9 @@ class Float32Report:
         if method == "exact" and self.ray_warns:
             return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
                     f"moves the first root by more than {T_TOL:g} on "
-                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (expect about "
-                    f"1/{RAY_TO_PIXELS} of that share of wrong pixels: exact's walk reads "
-                    "them)")
+                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (exact's walk "
+                    f"reads them: expect wrong pixels, {RAY_TO_PIXELS} of that share where "
+                    "measured)")
         if self.point_warns:
             return (f"float32 cannot hold this surface: a rounding of S moves it by more "
                     f"than {T_TOL:g} at {100 * self.point.far:.1f} % of its sampled points "

@@ -15,14 +15,15 @@ import sympy
 from cases import chmutov
 from conftest import require_backend
 
-from implc.chebyshev import chebyshev_program, surface_box
+from implc.chebyshev import chebyshev_program, chebyshev_ray_program, surface_box
 from implc.emit import emit
 from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
 from implc.numeric import evaluate, evaluate_program
+from implc.raypoly import coefficient_program
 from implc.render.run import render
-from implc.symbols import POINT
+from implc.symbols import DIRECTION, POINT
 
 SIZE = 192
 BAD_SHARE = 1e-4  # the issue's bound: 0.01 % of the pixels
@@ -44,18 +45,28 @@ def test_exact_in_float32_is_right_on_chmutov_t12(t12, backend):
     assert bad <= BAD_SHARE * SIZE * SIZE, m
 
 
-def test_clenshaw_program_is_s():
-    """The Chebyshev program is S: float64 values agree with S's at random points to
-    float64's rounding of S's terms."""
-    expr = load_surface(equation=chmutov(12)).expr
-    program = chebyshev_program(expr)
-    assert program is not None
+@pytest.mark.parametrize("degree", [12, 13])  # even series; odd ones (third kind)
+def test_clenshaw_programs_are_s_and_its_ray_coefficients(degree):
+    """The Chebyshev programs are S and the ray's coefficients: float64 values agree with
+    S's and with Horner's route's at random points and directions to float64's rounding
+    of their terms."""
+    expr = load_surface(equation=chmutov(degree)).expr
+    program, ray = chebyshev_program(expr), chebyshev_ray_program(expr)
+    assert program is not None and ray is not None
     rng = np.random.default_rng(7)
     points = rng.uniform(-1.4, 1.4, (3, 500))
-    env = dict(zip(POINT, points, strict=True))
+    directions = rng.normal(size=(3, 500))
+    directions /= np.linalg.norm(directions, axis=0)
+    env = {**dict(zip(POINT, points, strict=True)),
+           **dict(zip(DIRECTION, directions, strict=True))}
     (value,) = evaluate_program(program.assignments, program.outputs, env)
     exact = evaluate(expr, env)
     assert np.max(np.abs(value - exact) / (1 + np.abs(exact))) < 1e-9
+    horner = coefficient_program(expr, "double")
+    for mine, theirs in zip(evaluate_program(ray.assignments, ray.outputs, env),
+                            evaluate_program(horner.assignments, horner.outputs, env),
+                            strict=True):
+        assert np.max(np.abs(mine - theirs) / (1 + np.abs(theirs))) < 1e-8
 
 
 def test_clenshaw_in_float32_holds_t20_where_monomials_do_not():
