@@ -40,6 +40,10 @@ from .symbols import DIRECTION, POINT
 GAIN = 16.0
 # the surface's sampled points the box is chosen on, at most (every k-th sign change)
 BOX_POINTS = 1500
+# S's monomials above which its monomials are kept: the exact conversion's sympy work grows
+# with their number times the tensor basis's size (206 monomials of degree 10: 0.9 s with
+# the box's choice, most of it sampling; Chmutov's T_20 31)
+MAX_MONOMIALS = 400
 # the box's centre and half widths are rounded outwards to multiples of 2^-BOX_BITS of
 # the largest half width
 BOX_BITS = 6
@@ -55,7 +59,7 @@ def chebyshev_program(expr: sympy.Expr) -> Program | None:
 @lru_cache(maxsize=16)
 def _program(expr: sympy.Expr) -> Program | None:
     terms = expanded_terms(expr)
-    if not terms or not all(c.is_number for c in terms.values()):
+    if not terms or len(terms) > MAX_MONOMIALS or not all(c.is_number for c in terms.values()):
         return None
     box = surface_box(expr, terms)
     if box is None:
