@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import sympy
 
 from .conditioning import (
+    RAY_TO_PIXELS,
     RAY_WARN_SHARE,
     WARN_SHARE,
     Conditioning,
@@ -22,10 +23,9 @@ from .conditioning import (
 )
 from .derive import polynomial_degree
 from .options import EXACT_MAX_DEGREE, T_TOL
-from .raypoly import coefficient_program
 from .scaling import scale_exponent, scaled
 from .scene import View
-from .solver import ROBUST_NEWTON_BELOW
+from .solver import ROBUST_NEWTON_BELOW, exact_coefficients
 from .surface import Surface
 from .symbols import POINT
 
@@ -53,8 +53,9 @@ class Float32Report:
         if method == "exact" and self.ray_warns:
             return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
                     f"moves the first root by more than {T_TOL:g} on "
-                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (expect about "
-                    "that share of wrong pixels)")
+                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (exact's walk "
+                    f"reads them: expect wrong pixels, {RAY_TO_PIXELS} of that share where "
+                    "measured)")
         if self.point_warns:
             return (f"float32 cannot hold this surface: a rounding of S moves it by more "
                     f"than {T_TOL:g} at {100 * self.point.far:.1f} % of its sampled points "
@@ -74,7 +75,7 @@ def float32_report(expr: sympy.Expr, view: View, degree: int,
     expr = scaled(expr, scale)
     if gradient is not None:
         gradient = tuple(scaled(g, scale) for g in gradient)
-    rays = (ray_conditioning(coefficient_program(expr, "float"), view)
+    rays = (ray_conditioning(exact_coefficients(expr, "float"), view)
             if ray and ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
     if not point:
         return Float32Report(None, rays)

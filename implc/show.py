@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sympy
 
+from .conditioning import RAY_TO_PIXELS
 from .derive import Derivatives, polynomial_degree
 from .emit import build_functions, function_quantities
 from .float32 import float32_report
@@ -85,15 +86,15 @@ def _float32_lines(surface: Surface, degree: int,
              f"more than {T_TOL:g}, the distance the counts call a wrong root"]
     if report.point_warns:
         lines.append("           warning: float32 cannot hold this surface: expect wrong "
-                     "pixels from every method (exact's ray polynomial rounds worse still)")
+                     "pixels from every method (exact's own measure is below)")
     if ray is not None:
-        lines.append(f"           exact's ray coefficients (its Newton reads F from them from "
+        lines.append(f"           exact's ray coefficients (its walk reads them from "
                      f"degree {ROBUST_NEWTON_BELOW}), rounded as its shader rounds them, move "
                      f"the first root by {ray.median:.1e} (median), {ray.p90:.1e} (p90) on "
                      f"{ray.points:,} pixel rays; {100 * ray.far:.2f} % more than {T_TOL:g}")
         if report.ray_warns:
-            lines.append("           warning: expect about that share of exact's pixels "
-                         "with a wrong root in float32")
+            lines.append(f"           warning: expect wrong roots in float32 on {RAY_TO_PIXELS} "
+                         "of that share of exact's pixels (where measured)")
     scale = scale_exponent(surface.expr)
     if scale:
         lines.append(f"           measured as the shader computes S: {scale_note(scale)}")

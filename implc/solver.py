@@ -14,7 +14,7 @@ import sympy
 from .derive import polynomial_degree
 from .errors import InputError
 from .methods import Constants
-from .optimize import count_ops
+from .optimize import Program, count_ops
 from .options import EXACT_MAX_DEGREE, UNIT_ROUNDOFF
 from .pieces import (
     Marcher,
@@ -98,6 +98,21 @@ NEXT_FLOOR = 4
 FIRST_REACH = 8
 FIRST_HALVINGS = 3
 
+# Where the Newton after the walk reads Estrin's value of the chord's coefficients (from
+# ROBUST_NEWTON_BELOW) in float32 and S stays in monomials (no gain from Chebyshev's basis,
+# --params uniform, or no numpy), this many Newton steps on F's robust value (S at the
+# point) follow it, inside the root node. The chord's coefficients are a Taylor expansion
+# about the chord's middle, computed from S's monomials: in float32 their rounding can be a
+# share of terms far larger than F near its root (Chmutov's T_12 written in monomials, a
+# clip radius of 1.5), and Estrin's root lands up to 1e-2 from the root. Measured at 256^2
+# against the certified reference (scripts/float32_diagnosis.py): on T_12 with S in
+# monomials, the float32 program 33 bad pixels, with one step on S 5, with two 5 (S at the
+# point alone in float32, everything else in double: 2). Where S is in Chebyshev's basis
+# the Newton reads S throughout instead (lower_solver). On x^12 and x^20 sums and Barth's
+# decic the counts are unchanged (0 / 0 / 0, 0 / 0 / 0, 0 / 2 / 0). In double the
+# coefficients hold the root and nothing follows Estrin's Newton (programs unchanged).
+POLISH_STEPS = 2
+
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
@@ -147,6 +162,9 @@ class Solver:
     # bernstein: FIRST_REACH printed, FIRST_HALVINGS
     first_reach: str = ""
     first_halvings: int = 0
+    # bernstein, Newton on Estrin's value in float32: the Newton steps on F's robust value
+    # after it (POLISH_STEPS; 0: none)
+    polish: int = 0
 
 
 @dataclass(frozen=True)
@@ -203,6 +221,30 @@ def _value_function(name: str, n: int, printer, prefix: str,
         (printer.print_select(certain, "h", at_point),))
 
 
+def _chebyshev(expr: sympy.Expr, precision: str, ray: bool) -> Program | None:
+    """S (or, with `ray`, the ray's coefficients) from S in Chebyshev's basis of its box
+    (implc/chebyshev.py), where exact's program takes them: in float32, from
+    ROBUST_NEWTON_BELOW (where its Newton and walk read them), where that basis holds S
+    better than its monomials; else None. The box is found by sampling S with numpy:
+    where numpy cannot load (the compile path needs only sympy and jinja2, issue 43), S's
+    monomials are kept, and such a program differs from the one compiled with numpy."""
+    if precision != "float" or (polynomial_degree(expr) or 0) < ROBUST_NEWTON_BELOW:
+        return None
+    try:
+        from .chebyshev import chebyshev_program, chebyshev_ray_program
+    except ImportError:  # numpy missing
+        return None
+    if chebyshev_program(expr) is None:
+        return None
+    return chebyshev_ray_program(expr) if ray else chebyshev_program(expr)
+
+
+def exact_coefficients(expr: sympy.Expr, precision: str) -> Program:
+    """The program of the ray's coefficients exact's shader computes in `precision`."""
+    chebyshev = _chebyshev(expr, precision, ray=True)
+    return chebyshev if chebyshev is not None else coefficient_program(expr, precision)
+
+
 def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                   max_derived: int, carried: tuple[tuple[str, str], ...]) -> Solving:
     """The pieces of templates/solver.j2: S and grad at the point (shading, residual),
@@ -211,9 +253,12 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     that place the critical points are bound by their chains: 7 % a frame on the quartics,
     29 % at degree 12), F itself too, with the rounding bound ROUND_ERR states."""
     programs = build_programs(expr, (("S",), ("grad",)), max_derived)
+    chebyshev = _chebyshev(expr, printer.precision, ray=False)
+    if chebyshev is not None:  # where float32 cannot hold S's monomials
+        programs["S"] = chebyshev
     functions = [point_function(name, program, printer, carried)
                  for name, program in programs.items()]
-    coefficients = coefficient_program(expr, printer.precision)
+    coefficients = exact_coefficients(expr, printer.precision)
     n = len(coefficients.outputs) - 1
     u = sym("u")
     bernstein = n >= BERNSTEIN_FROM
@@ -260,14 +305,20 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         # end than near the root, and the secant starts next to the other end. Measured on
         # x^18 + y^18 + z^18 = 1 at 512^2: 6.3 -> 4.5 Newton steps a hit pixel, 7 % a frame.
         control_w = tuple(printer.float_literal(-1 + 2 * i / n) for i in range(n + 1))
-        robust_newton = n < ROBUST_NEWTON_BELOW
+        # S in Chebyshev's basis holds F where the chord's coefficients do not: Newton on it
+        # throughout (T_16, T_18, T_20 at 256^2: 29, 300, 1,683 wrong roots with Estrin's
+        # Newton and two polishing steps, 22, 115, 740 with Newton on S, at about the
+        # same frame: 0.74 -> 0.65, 0.83 -> 0.79, 0.67 -> 0.71 of taylor's)
+        robust_newton = n < ROBUST_NEWTON_BELOW or chebyshev is not None
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
                         control_w, printer.float_literal(2 / n), robust_newton,
                         tuple((level, printer.float_literal(0.5 ** level), pairs)
                               for level, pairs in descent_levels(n)),
                         printer.float_literal(NEXT_REACH / n),
                         printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS,
-                        printer.float_literal(FIRST_REACH), FIRST_HALVINGS)
+                        printer.float_literal(FIRST_REACH), FIRST_HALVINGS,
+                        POLISH_STEPS if not robust_newton and printer.precision == "float"
+                        else 0)
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(

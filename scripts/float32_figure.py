@@ -1,7 +1,8 @@
 """Why the sweep's Chmutov rows miss 0.67 in float32 from degree 17: a picture
 (docs/float32-chmutov.png, docs/RESULTS.md, "The degree sweep").
 
-    python scripts/float32_figure.py --degree 20 --size 384 -o docs/float32-chmutov.png
+    python scripts/float32_figure.py --degree 20 --size 384 -o docs/float32-chmutov.png \
+        --before old.frag    (exact's float32 GLSL program from an earlier commit, drawn beside)
 
 Chmutov's T_n + T_n + T_n = 0 as the sweep writes it (scripts/eval_forms.py), in the
 sweep's view: exact in float32 (gl) and in double (gl-double) and taylor in float32,
@@ -38,12 +39,27 @@ def disagreement(result, double) -> np.ndarray:
     return (result.hit != double.hit) | (both & (np.abs(result.t - double.t) > WRONG))
 
 
+def _before(path: Path, surface, size: int):
+    """An earlier commit's exact float32 GLSL program, rendered on gl in the same view."""
+    from implc.emit import render_template
+    from implc.render.gl import GlRunner
+
+    vertex = render_template("glsl/fullscreen.vert.j2", version="330 core")
+    runner = GlRunner(path.read_text(), vertex, surface.view, size, size)
+    try:
+        return runner.frame()
+    finally:
+        runner.release()
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--degree", type=int, default=20)
     ap.add_argument("--size", type=int, default=384)
     ap.add_argument("-o", "--output", default=str(ROOT / "docs" / "float32-chmutov.png"))
+    ap.add_argument("--before", help="exact's float32 GLSL program (330) of an earlier "
+                    "commit: drawn beside the current one")
     args = ap.parse_args()
 
     import matplotlib
@@ -57,14 +73,18 @@ def main() -> None:
     runs = {"exact, float32": render(surface, "gl", "exact", exact, size, size),
             "exact, double": render(surface, "gl-double", "exact", exact, size, size),
             "taylor, float32": render(surface, "gl", "taylor", taylor, size, size)}
+    if args.before:
+        runs = {"exact, float32 before": _before(Path(args.before), surface, size), **runs}
     double = runs["exact, double"]
-    fig, axes = plt.subplots(2, 3, figsize=(12, 8.6), dpi=80)
+    columns = len(runs)
+    fig, axes = plt.subplots(2, columns, figsize=(4 * columns, 8.6), dpi=80)
     for ax, (name, result) in zip(axes[0], runs.items(), strict=True):
         ax.imshow(np.clip(result.color, 0, 1))
         ax.set_title(f"T{args.degree}: {name}")
     top = max(float(np.percentile(r.steps[r.steps > 0], 99.5))
               for name, r in runs.items() if name.startswith("exact"))
-    for ax, name in zip(axes[1][:2], ("exact, float32", "exact, double"), strict=True):
+    exacts = [name for name in runs if name.startswith("exact")]
+    for ax, name in zip(axes[1][:len(exacts)], exacts, strict=True):
         steps = runs[name].steps
         shown = ax.imshow(steps, cmap="magma", vmin=0, vmax=top)
         block = steps[: size // 4 * 4, : size // 4 * 4].reshape(size // 4, 4, size // 4, 4)
@@ -78,12 +98,16 @@ def main() -> None:
     wrong[by_exact & ~by_taylor] = (1.0, 0.5, 0.0)
     wrong[by_taylor & ~by_exact] = (0.2, 0.4, 1.0)
     wrong[by_exact & by_taylor] = (1.0, 1.0, 1.0)
-    axes[1][2].imshow(wrong)
-    shares = {"exact, float32": by_exact.mean(), "taylor, float32": by_taylor.mean()}
-    axes[1][2].set_title(f"> {WRONG:g} from exact in double, or a hit on one side:\n"
-                         f"exact float32 {100 * shares['exact, float32']:.0f} % (orange), "
-                         f"taylor float32 {100 * shares['taylor, float32']:.0f} % (blue),\n"
-                         f"both: white", fontsize=9)
+    axes[1][-1].imshow(wrong)
+    shares = {name: disagreement(runs[name], double).mean()
+              for name in runs if name != "exact, double"}
+    before = (f"; before {100 * shares['exact, float32 before']:.1f} %"
+              if "exact, float32 before" in shares else "")
+    axes[1][-1].set_title(f"> {WRONG:g} from exact in double, or a hit on one side:\n"
+                          f"exact float32 {100 * shares['exact, float32']:.2f} % (orange"
+                          f"{before}),\ntaylor float32 "
+                          f"{100 * shares['taylor, float32']:.0f} % (blue), both: white",
+                          fontsize=9)
     for ax in axes.flat:
         ax.set_xticks([])
         ax.set_yticks([])
