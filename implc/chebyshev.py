@@ -130,14 +130,17 @@ def _dyadic(center: np.ndarray, half: np.ndarray) -> Box:
 
 
 def _slope(monomials: np.ndarray, values: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """|grad S| at the points, from S's monomials."""
+    """|grad S| at the points, from S's monomials (each power of each coordinate once)."""
+    top = int(monomials.max())
+    powers = points[:, None, :] ** np.arange(top + 1)[None, :, None]  # (points, k, axis)
     grad = []
     for axis in range(3):
         e = monomials[:, axis]
         lowered = monomials.copy()
         lowered[:, axis] = np.maximum(e - 1, 0)
-        powers = np.prod(points[:, None, :] ** lowered[None], axis=2)
-        grad.append(powers @ (values * e))
+        terms = (powers[:, lowered[:, 0], 0] * powers[:, lowered[:, 1], 1]
+                 * powers[:, lowered[:, 2], 2])
+        grad.append(terms @ (values * e))
     return np.sqrt(sum(g * g for g in grad))
 
 
@@ -153,21 +156,34 @@ def _chebyshev_table(t: np.ndarray, top: int) -> np.ndarray:
 
 def _float_coefficients(monomials: np.ndarray, values: np.ndarray, box) -> np.ndarray:
     """b_lmn in float64 (a dense array), for choosing the box."""
-    from numpy.polynomial import chebyshev, polynomial
-
     top = int(monomials.max())
-    per_axis = []
-    for c, h in box:
-        rows = np.zeros((top + 1, top + 1))
-        for e in sorted(set(monomials.ravel().tolist())):
-            power = polynomial.polypow([float(c), float(h)], e)
-            cheb = chebyshev.poly2cheb(power)
-            rows[e, :len(cheb)] = cheb
-        per_axis.append(rows)
+    per_axis = [_power_rows(float(c), float(h), top) for c, h in box]
     b = np.zeros((top + 1,) * 3)
     for (i, j, k), a in zip(monomials, values, strict=True):
         b += a * np.einsum("l,m,n->lmn", per_axis[0][i], per_axis[1][j], per_axis[2][k])
     return b
+
+
+def _power_rows(c: float, h: float, top: int) -> np.ndarray:
+    """Row e: v^e with v = c + h t in Chebyshev's basis of t, for e = 0..top."""
+    in_t = np.zeros((top + 1, top + 1))  # row e: the power coefficients of (c + h t)^e
+    in_t[0, 0] = 1.0
+    for e in range(1, top + 1):
+        in_t[e, 1:] = h * in_t[e - 1, :-1]
+        in_t[e] += c * in_t[e - 1]
+    return in_t @ _powers_in_chebyshev(top)
+
+
+@lru_cache(maxsize=8)
+def _powers_in_chebyshev(top: int) -> np.ndarray:
+    """Row j: t^j in Chebyshev's basis, j = 0..top (read, never changed)."""
+    from numpy.polynomial import chebyshev
+
+    table = np.zeros((top + 1, top + 1))
+    for j in range(top + 1):
+        row = chebyshev.poly2cheb(np.eye(top + 1)[j])
+        table[j, :len(row)] = row
+    return table
 
 
 def _chebyshev_magnitude(b: np.ndarray, points: np.ndarray, box) -> np.ndarray:
