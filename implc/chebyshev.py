@@ -58,6 +58,15 @@ def chebyshev_program(expr: sympy.Expr) -> Program | None:
 
 @lru_cache(maxsize=16)
 def _program(expr: sympy.Expr) -> Program | None:
+    converted = _converted(expr)
+    return None if converted is None else _clenshaw_program(*converted[:2])
+
+
+@lru_cache(maxsize=16)
+def _converted(expr: sympy.Expr) -> tuple[dict, Box, int] | None:
+    """(S's exact coefficients in Chebyshev's basis of its box, the box, S's degree), or
+    None where S keeps its monomials; once for S at the point and the ray's coefficients
+    (read, never changed)."""
     terms = expanded_terms(expr)
     if not terms or len(terms) > MAX_MONOMIALS or not all(c.is_number for c in terms.values()):
         return None
@@ -66,7 +75,7 @@ def _program(expr: sympy.Expr) -> Program | None:
         return None
     coefficients = tensor_coefficients({m: sympy.nsimplify(c) if c.is_Float else c
                                         for m, c in terms.items()}, box)
-    return _clenshaw_program(coefficients, box)
+    return coefficients, box, max(sum(m) for m in terms)
 
 
 def surface_box(expr: sympy.Expr, terms: dict | None = None) -> Box | None:
@@ -349,14 +358,8 @@ def chebyshev_ray_program(expr: sympy.Expr) -> Program | None:
 
 @lru_cache(maxsize=16)
 def _ray_program(expr: sympy.Expr) -> Program | None:
-    if _program(expr) is None:
-        return None
-    terms = expanded_terms(expr)
-    box = surface_box(expr, terms)
-    coefficients = tensor_coefficients({m: sympy.nsimplify(c) if c.is_Float else c
-                                        for m, c in terms.items()}, box)
-    n = max(sum(m) for m in terms)
-    return _clenshaw_program(coefficients, box, n)
+    converted = _converted(expr)
+    return None if converted is None else _clenshaw_program(*converted)
 
 
 def _number(value: sympy.Rational) -> sympy.Expr:
