@@ -9,6 +9,8 @@ below degree 10. `make test` samples degrees
 
     IMPLC_GPU_DEGREES=2-20 pytest tests/test_gpu_stats.py
 
+The occupancy guard: exact holds at most EXACT_VGPRS VGPRs on RDNA2 from degree 13 on.
+
 Double (GLSL 450) does spill from degree 10 on gfx1100 (and 6 SGPRs of exact from 12 on
 navi21); scripts/gpu_stats_table.py measures and lists it (docs/RESULTS.md, "What a GPU's compiler
 says").
