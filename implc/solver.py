@@ -396,7 +396,7 @@ class WalkCost:
 def walk_cost(n: int, s_ops: int) -> WalkCost:
     """WalkCost of a degree-n walk whose S costs `s_ops` at a point."""
     shift = n * (n + 1)  # n(n + 1)/2 multiply-adds
-    scaling = 2 * n - 1
+    scaling = 2 * n  # c_k nr^k (n products, n - 1 powers of nr) and nm/nr
     sums = sum(count_ops(even) + (count_ops(odd) + 2 if odd is not None else 0)
                for _, even, odd in bernstein_sums(n))
     signs = 2 * n  # a product and a comparison for each neighbouring pair

@@ -9,6 +9,8 @@ below degree 10. `make test` samples degrees
 
     IMPLC_GPU_DEGREES=2-20 pytest tests/test_gpu_stats.py
 
+The occupancy guard: exact holds at most EXACT_VGPRS VGPRs on RDNA2 from degree 13 on.
+
 Double (GLSL 450) does spill from degree 10 on gfx1100 (and 6 SGPRs of exact from 12 on
 navi21); scripts/gpu_stats_table.py measures and lists it (docs/RESULTS.md, "What a GPU's compiler
 says").
@@ -85,6 +87,32 @@ def test_no_method_spills(radv) -> None:
               for rows in gpu_stats(shaders, GPU_FAMILIES).values()
               for key, stats in zip(keys, rows, strict=True) if stats.spills]
     assert not spills, "\n".join(spills)
+
+
+# exact's registers on RDNA2 in float (HLSL and GLSL 450): at most this many VGPRs from
+# degree 13 to 20 (issue 49's bound, 10 waves per SIMD). The Bernstein walk scales the
+# chord's coefficients before its Taylor shift, so a node's coefficients come out scaled:
+# scaled after it, ACO fused the scaling into the Bernstein sums and held every unscaled
+# coefficient and every power of the half width at once (112 VGPRs at degree 20, 8 waves;
+# now 88, 10). Below degree 13 the peak is the ray's coefficients (ray_of), not the walk.
+EXACT_VGPRS = 96
+EXACT_VGPRS_FROM = 13
+
+
+def test_exact_holds_few_registers(radv) -> None:
+    """exact's float programs on RDNA2 (navi21), Chmutov T_n over the sampled degrees from
+    EXACT_VGPRS_FROM (and 20): at most EXACT_VGPRS VGPRs."""
+    degrees = sorted({n for n in _degrees() if n >= EXACT_VGPRS_FROM} | {20})
+    keys, shaders = [], []
+    for n in degrees:
+        surface = implc.Surface(chmutov(n))
+        for target, flavor, precision in PROGRAMS:
+            shaders.append(surface.compile(target, "exact", flavor=flavor, precision=precision))
+            keys.append(f"chmutov {n} {target}")
+    rows = gpu_stats(shaders, ("navi21",))["navi21"]
+    over = [f"{key}: {stats.line()}" for key, stats in zip(keys, rows, strict=True)
+            if stats.vgprs > EXACT_VGPRS]
+    assert not over, "\n".join(over)
 
 
 def test_show_prints_the_statistics(radv) -> None:
