@@ -124,9 +124,14 @@ def backends(degrees: list[int], size: int, names: list[str]) -> None:
                 m = compare(runner.frame(), reference)
             finally:
                 runner.release()
-            bad = m["false_hits"] + m["missed_hits"] + m["wrong_root"]
-            print(f"| T_{n} | {backend} | {m['false_hits']} / {m['missed_hits']} / "
-                  f"{m['wrong_root']} | {bad} ({100 * bad / m['pixels']:.4f} %) |", flush=True)
+            print(_counts_row(n, backend, m, 4), flush=True)
+
+
+def _counts_row(n: int, label: str, m: dict, digits: int) -> str:
+    """A table row: false / missed / wrong pixels and their share of the picture."""
+    bad = m["false_hits"] + m["missed_hits"] + m["wrong_root"]
+    return (f"| T_{n} | {label} | {m['false_hits']} / {m['missed_hits']} / "
+            f"{m['wrong_root']} | {bad} ({100 * bad / m['pixels']:.{digits}f} %) |")
 
 
 def _degrees(text: str) -> list[int]:
@@ -195,9 +200,7 @@ def main() -> None:
                 m = compare(runner.frame(), reference)
             finally:
                 runner.release()
-            bad = m["false_hits"] + m["missed_hits"] + m["wrong_root"]
-            print(f"| T_{n} | {name} | {m['false_hits']} / {m['missed_hits']} / "
-                  f"{m['wrong_root']} | {bad} ({100 * bad / m['pixels']:.3f} %) |", flush=True)
+            print(_counts_row(n, name, m, 3), flush=True)
 
 
 if __name__ == "__main__":

@@ -18,12 +18,12 @@ statistics of both programs (GLSL 450 through glslang) on navi21 and gfx1100.
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
 from pathlib import Path
 
 from docs_section import commit, machine, replace_marked
 from eval_forms import float32_holds, sweep_equations
+from gpu_bench import median_ms
 
 from implc.baseline import (
     has_baseline,
@@ -31,7 +31,6 @@ from implc.baseline import (
     open_solver_runner,
     solver_shader,
 )
-from implc.bench import time_interleaved
 from implc.derive import polynomial_degree
 from implc.emit import compile_shader
 from implc.loaders import load_surface
@@ -61,12 +60,7 @@ def timed(key: str, surface, precision: str, size: int, frames: int) -> list[flo
                open_solver_runner(SOLVER, surface, constants, size, size, precision)]
     if precision == "float" and has_baseline(key, "exact"):
         runners.append(open_baseline_runner(key, "exact", constants, surface, size, size))
-    try:
-        seconds, _, _ = time_interleaved(runners, frames)
-    finally:
-        for runner in runners:
-            runner.release()
-    return [1000 * statistics.median(s) for s in seconds]
+    return median_ms(runners, frames)
 
 
 def counted(surface, precision: str, size: int) -> list[dict]:
