@@ -125,19 +125,19 @@ forms: setup
 
 # What AMD's compiler makes of the degree sweep (issue 49): RADV's ACO statistics on null
 # devices (no GPU needed) of Chmutov T_2..T_20's programs, every method, float and double,
-# written into docs/RESULTS.md, "What a GPU's compiler says" (scripts/gpu_stats_table.py). About 2 minutes.
+# written into docs/results-gpu.md, "What a GPU's compiler says" (scripts/gpu_stats_table.py). About 2 minutes.
 .PHONY: gpu-stats-table gpu-bench
 gpu-stats-table: setup
-	$(PY) scripts/gpu_stats_table.py --write docs/RESULTS.md
+	$(PY) scripts/gpu_stats_table.py --write docs/results-gpu.md
 
 # implc's exact against Yuksel's first-root solver written by hand, spill-free (issue 49):
 # Chmutov T4, T10, T16, T20 and Barth's decic at 512^2 in turns, counts against the
 # certified reference (smaller at T16 and T20, whose reference takes hours at 512^2), ACO
-# statistics; written into docs/RESULTS.md. About 15 minutes.
+# statistics; written into docs/results-gpu.md. About 15 minutes.
 .PHONY: yuksel-baseline
 yuksel-baseline: setup
 	$(PY) scripts/yuksel_baseline.py --size 512 --frames 5 --degrees 4,10,16,20 \
-	  --count-size 512,16=128,20=96 barth-decic --write docs/RESULTS.md
+	  --count-size 512,16=128,20=96 barth-decic --write docs/results-gpu.md
 
 # For a machine with a real GPU: the frame table of every method over Chmutov T_2..T_20
 # and the hand-written baselines at 1024^2 and 2048^2, the device named

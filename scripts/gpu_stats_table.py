@@ -5,7 +5,7 @@ spill of every method (exact, taylor, hessian, interval) in float (HLSL, GLSL 45
 double (GLSL 450; HLSL has float only). About 2 minutes.
 
     python scripts/gpu_stats_table.py                       print the Markdown
-    python scripts/gpu_stats_table.py --write docs/RESULTS.md
+    python scripts/gpu_stats_table.py --write docs/results-gpu.md
         replace the part between <!-- gpu-stats:begin --> and <!-- gpu-stats:end -->
 """
 

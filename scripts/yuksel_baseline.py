@@ -1,10 +1,10 @@
 """implc's generated `exact` against the strongest published solver (issue 49, point 3):
 Yuksel's first-root solver in GLSL, written spill-free (templates/baseline/yuksel.frag.j2,
 implc/baseline.py SOLVERS), on the same ray polynomial, camera and shading
-(docs/RESULTS.md, "The strongest published solver as a baseline").
+(docs/results-gpu.md, "The strongest published solver as a baseline").
 
     python scripts/yuksel_baseline.py --size 512 --degrees 4,10,16,20 barth-decic
-    python scripts/yuksel_baseline.py --count-size 512,16=128,20=96 --write docs/RESULTS.md
+    python scripts/yuksel_baseline.py --count-size 512,16=128,20=96 --write docs/results-gpu.md
 
 Per row (Chmutov's T_n of eval_forms' sweep, or a named surface): both programs, and
 Barth's hand-written decic where the surface has one, timed in turns on llvmpipe (one

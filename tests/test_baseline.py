@@ -85,7 +85,7 @@ def test_solver_baseline_validates(name, degree, precision):
 def test_solver_baseline_finds_the_references_roots(name, degree):
     """Chmutov's T4 and T10 at 96x96, in float32 (which holds them): the hand-written
     solver hits where the reference hits, at its root. Measured 0 / 0 / 0 for both here
-    (at 512^2, docs/RESULTS.md: T4 0 / 0 / 0, T10 1 / 1 / 11 of 262,144); the bound is the
+    (at 512^2, docs/results-gpu.md: T4 0 / 0 / 0, T10 1 / 1 / 11 of 262,144); the bound is the
     decic baseline's, 1 false hit and 2 missed or wrong pixels of 9,216, since Yuksel's
     solver has no touching-root test (a ray grazing a sheet closer than float32 resolves
     can fall either way). With the collapse of a rootless interval broken (onto lo instead
@@ -109,7 +109,7 @@ def test_solver_baseline_does_not_spill():
     """Written spill-free in Peters' way, and so it stays on RDNA2 (navi21): in float
     nothing spills at degree 4, 10 and 20; in double (T16) no VGPR spills and no scratch
     is used (6 SGPRs spill there, as they do for implc's exact in double from degree 12:
-    docs/RESULTS.md). With the binomials on the coefficients instead of on x, ACO kept
+    docs/results-gpu.md). With the binomials on the coefficients instead of on x, ACO kept
     every level's coefficients live: 16 VGPRs spilled at T16 in double, 1,125 at T20."""
     require_tool("glslangValidator")
     if problem := radv_problem():

@@ -12,8 +12,8 @@ below degree 10. `make test` samples degrees
 The occupancy guard: exact holds at most EXACT_VGPRS VGPRs on RDNA2 from degree 13 on.
 
 Double (GLSL 450) does spill from degree 10 on gfx1100 (and 6 SGPRs of exact from 12 on
-navi21); scripts/gpu_stats_table.py measures and lists it (docs/RESULTS.md, "What a GPU's compiler
-says").
+navi21); scripts/gpu_stats_table.py measures and lists it (docs/results-gpu.md, "What a
+GPU's compiler says").
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ BUNDLED = ("barth-decic", "barth-sextic", "clebsch")
 ROOT = Path(__file__).resolve().parent.parent
 # the float programs that reach SPIR-V: (target, flavour, precision)
 PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
-# double (GLSL 450) spills from degree 10 on gfx1100 (docs/RESULTS.md, "What a GPU's compiler
+# double (GLSL 450) spills from degree 10 on gfx1100 (docs/results-gpu.md, "What a GPU's compiler
 # says"): guarded
 # below that, on the sampled degrees and the bundled sextic
 DOUBLE = (("glsl", "450", "double"),)
