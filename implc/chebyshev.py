@@ -70,7 +70,7 @@ def _converted(expr: sympy.Expr) -> tuple[dict, Box, int] | None:
     terms = expanded_terms(expr)
     if not terms or len(terms) > MAX_MONOMIALS or not all(c.is_number for c in terms.values()):
         return None
-    box = surface_box(expr, terms)
+    box = surface_box(expr)
     if box is None:
         return None
     coefficients = tensor_coefficients({m: sympy.nsimplify(c) if c.is_Float else c
@@ -78,7 +78,7 @@ def _converted(expr: sympy.Expr) -> tuple[dict, Box, int] | None:
     return coefficients, box, max(sum(m) for m in terms)
 
 
-def surface_box(expr: sympy.Expr, terms: dict | None = None) -> Box | None:
+def surface_box(expr: sympy.Expr) -> Box | None:
     """(centre, half width) per axis, dyadic, of the box whose Chebyshev basis moves S's
     sampled surface least in float32, or None: no surface found, or the monomials move it
     less than GAIN times as far. The candidates are the boxes holding a share
@@ -87,7 +87,7 @@ def surface_box(expr: sympy.Expr, terms: dict | None = None) -> Box | None:
     surfaces, sheets to infinity) the core where most of it lies. The measure is
     conditioning.py's, in each basis: the terms' magnitudes at each point over |grad S|,
     its 90th percentile over the points."""
-    terms = expanded_terms(expr) if terms is None else terms
+    terms = expanded_terms(expr)
     extent = locate_surface(expr)
     if extent is None:
         return None

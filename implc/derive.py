@@ -346,12 +346,14 @@ def _times(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
     return result
 
 
+@lru_cache(maxsize=16)
 def expanded_terms(expr: sympy.Expr) -> dict[tuple[int, int, int], sympy.Expr]:
     """S's monomials {(i, j, k): c} (c x^i y^j z^k, c not 0), by polynomial arithmetic on
     monomial dictionaries over S's distinct sub-expressions: what `sympy.Poly(S).terms()`
     gives, without sympy's general expansion (a product of ten dense quadratics, 1,771
     monomials: 9.6 s there, a fraction of a second here). A sub-expression free of x, y, z
-    (a number, sqrt(5), a parameter kept as a symbol) is a coefficient."""
+    (a number, sqrt(5), a parameter kept as a symbol) is a coefficient. Cached (framing,
+    Horner's plan and Chebyshev's basis ask for the same): read, never changed."""
     point = set(POINT)
     one = 1
 

@@ -141,9 +141,8 @@ def _degrees(text: str) -> list[int]:
 
 def timing(degrees: list[int], size: int, frames: int, before: str | None) -> None:
     """exact (and the --before programs) against taylor, float32 on gl, in turns."""
-    import statistics
+    from gpu_bench import median_ms
 
-    from implc.bench import time_interleaved
     from implc.marcher import choose_form
     from implc.render.run import open_runner
 
@@ -160,12 +159,7 @@ def timing(degrees: list[int], size: int, frames: int, before: str | None) -> No
         if before:
             text = (Path(before) / f"T{n}.frag").read_text()
             runners.append(GlRunner(text, vertex, surface.view, size, size))
-        try:
-            seconds, _, _ = time_interleaved(runners, frames)
-        finally:
-            for runner in runners:
-                runner.release()
-        ms = [1000 * statistics.median(s) for s in seconds]
+        ms = median_ms(runners, frames)
         old = f"{ms[2]:.1f} | {ms[2] / ms[1]:.2f}" if before else "| "
         print(f"| T_{n} | {ms[0]:.1f} | {ms[1]:.1f} | {ms[0] / ms[1]:.2f} | {old} |",
               flush=True)
