@@ -12,6 +12,7 @@ error, not an empty string.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cache
 
@@ -34,6 +35,8 @@ from .targets import TARGETS, flavor_problem, get_target, prefix_problem
 EMITS = ("program", "library")
 PARAM_MODES = ("constant", "uniform")
 PARAM_UNIFORM_PREFIX = "u_param_"  # parameter R is the uniform u_param_R
+# levels of the camera's continued fraction for tan(fov_y/2) (templates/camera.j2)
+CAMERA_LEVELS = 8
 
 
 @dataclass(frozen=True)
@@ -243,6 +246,9 @@ def compile_shader(
         "declare_params": declare_params,
         "shading": print_shading(surface.view, shade_printer),
         "view": _print_view(surface.view, shade_printer),
+        "camera": {"levels": [shade_printer.float_literal(float(k))
+                              for k in range(2 * CAMERA_LEVELS + 1, 0, -2)],
+                   "half_degree": shade_printer.float_literal(math.pi / 360)},
     }
     template = environment(tgt.name).get_template(tgt.templates[emit_form])
     return CompiledShader(template.render(context), tgt.name, meth.name, marcher.form,

@@ -45,6 +45,8 @@ class Backend:
     # "module:function" that opens the backend's runtime (a GL context, a wgpu device, an
     # OpenCL device) or raises ToolError saying why not: tests skip (or fail under CI) on it
     probe: str = ""
+    # the flavour of the target's program it runs ("": the target's default)
+    flavor: str = ""
 
 
 # GLSL flavour -> how the program form is framed (read by templates/glsl/program.glsl.j2).
@@ -191,7 +193,11 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
                                        "the same with the surface solved in double "
                                        "(needs GL_ARB_gpu_shader_fp64)",
                                        precision="double",
-                                       probe="implc.render.gl:double_context")},
+                                       probe="implc.render.gl:double_context"),
+                  "webgl2": Backend("implc.render.browser_runner:open_webgl2_runner",
+                                    "GLSL ES 3.00 in Chromium's WebGL2 (ANGLE on SwiftShader; "
+                                    "playwright)", flavor="es300",
+                                    probe="implc.render.browser_runner:chromium_renderer")},
         flavors=GLSL_FLAVORS,
         default_flavor="330",  # also the program the gl backend runs (render/gl.py)
         vector_types={"float": ("float", "vec2", "vec3", "vec4"),
@@ -219,7 +225,11 @@ TARGETS: dict[str, Target] = {target.name: target for target in (
         validator="implc.validate:validate_wgsl",
         backends={"wgpu": Backend("implc.render.wgpu_runner:open_wgpu_runner",
                                   "WGSL compute shader on wgpu (Vulkan; lavapipe here)",
-                                  probe="implc.devices:wgpu_device")},
+                                  probe="implc.devices:wgpu_device"),
+                  "webgpu": Backend("implc.render.browser_runner:open_webgpu_runner",
+                                    "WGSL in Chromium's WebGPU (Dawn on SwiftShader; "
+                                    "playwright)",
+                                    probe="implc.render.browser_runner:chromium_renderer")},
         # the program's parameters are fields of struct Uniforms after the camera (the
         # host writes it as bytes: render/wgpu_runner.py); a library's, of its Params
         param_layout={"program": ParamLayout(ref="u.{uniform}", offset=76),

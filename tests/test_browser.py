@@ -37,7 +37,7 @@ from implc.emit import emit, param_uniforms, render_template
 from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.render.run import render
-from implc.render.wgpu_runner import _uniforms
+from implc.render.wgpu_runner import uniform_block
 from implc.scene import SHADING, pixel_rays
 
 SMALL = 128
@@ -131,7 +131,7 @@ def test_wgsl_program_renders_in_chromium_like_wgpu(webgpu, example):
     page, log = webgpu
     surface = load_surface(example)
     program = emit(surface, "wgsl", "hessian", hessian())
-    uniforms = np.frombuffer(_uniforms(surface.view, SMALL, SMALL), np.float32).tolist()
+    uniforms = np.frombuffer(uniform_block(surface.view, SMALL, SMALL), np.float32).tolist()
     out = page.evaluate("([code, w, h, u]) => implcWebGPU.render(code, w, h, u)",
                         [program, SMALL, SMALL, uniforms])
     color, aux = _decode(out["color"], SMALL, SMALL), _decode(out["aux"], SMALL, SMALL)

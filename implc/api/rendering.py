@@ -67,7 +67,8 @@ def render_surface(surface: Framable, size: int | None = 512, *, width: int | No
     else:
         shader = compile_record(
             surface, record, backend_target(backend).name, method, emit="program",
-            prefix="", flavor=None, precision=None if BACKENDS[backend].precision == "float"
+            prefix="", flavor=BACKENDS[backend].flavor or None,
+            precision=None if BACKENDS[backend].precision == "float"
             else BACKENDS[backend].precision, params=params, constants=constants, notes=notes)
         runner = open_shader_runner(shader, backend, record.view, w, h)
         notes = shader.notes

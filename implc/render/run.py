@@ -86,11 +86,13 @@ def open_runner(
 
 def compile_backend_shader(surface: Surface, backend: str, method: str, constants: Constants,
                            params: str = "constant") -> CompiledShader:
-    """The program `backend` runs: its target's default flavour at its precision."""
+    """The program `backend` runs: its flavour (the target's default unless the backend
+    names one) at its precision."""
     from ..emit import compile_shader
 
     target = backend_target(backend)
-    return compile_shader(surface, target.name, method, constants, target.default_flavor,
+    flavor = BACKENDS[backend].flavor or target.default_flavor
+    return compile_shader(surface, target.name, method, constants, flavor,
                           precision=BACKENDS[backend].precision, params=params)
 
 

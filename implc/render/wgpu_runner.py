@@ -27,7 +27,7 @@ UNIFORM_FLOATS = 20  # struct Uniforms: 80 bytes (docs/reference/drop-ins.md "Dr
 # (WGSL)")
 
 
-def _uniforms(view: View, width: int, height: int,
+def uniform_block(view: View, width: int, height: int,
               params: Sequence[ParamUniform] = (), values: Mapping[str, float] | None = None,
               ) -> bytes:
     """The `Uniforms` block, laid out as the WGSL uniform address space requires
@@ -83,7 +83,7 @@ class WgpuRunner(TimedRunner):
             raise ToolError(f"wgpu rejected the shader: {err}") from err
         usage = wgpu.BufferUsage
         self.uniforms = dev.create_buffer_with_data(
-            data=_uniforms(view, width, height, self.params),
+            data=uniform_block(view, width, height, self.params),
             usage=usage.UNIFORM | usage.COPY_DST)
         self.color = dev.create_texture(
             size=(width, height, 1), format=COLOR_FORMAT,
@@ -107,7 +107,7 @@ class WgpuRunner(TimedRunner):
         if unknown:
             raise KeyError(f"not a uniform parameter: {', '.join(sorted(unknown))}")
         self.values.update({k: float(v) for k, v in values.items()})
-        self.device.queue.write_buffer(self.uniforms, 0, _uniforms(
+        self.device.queue.write_buffer(self.uniforms, 0, uniform_block(
             self.view, self.width, self.height, self.params, self.values))
 
     def draw(self) -> None:

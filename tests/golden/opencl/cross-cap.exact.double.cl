@@ -407,6 +407,21 @@ double3 shade(double3 g, double3 rd) {
     }
     return clamp(color, (double3)(0.0, 0.0, 0.0), (double3)(1.0, 1.0, 1.0));
 }
+// tan(fov_y/2) of fov_y in degrees by Lambert's continued fraction, 8 levels: within
+// 1e-6 of tan's value up to 170 degrees, on any driver (its own tan may be coarse).
+double tan_half_fov(double fov_y) {
+    double u = fov_y*0.008726646259971648;
+    double d = 17.0;
+    d = 15.0 - u*u/d;
+    d = 13.0 - u*u/d;
+    d = 11.0 - u*u/d;
+    d = 9.0 - u*u/d;
+    d = 7.0 - u*u/d;
+    d = 5.0 - u*u/d;
+    d = 3.0 - u*u/d;
+    d = 1.0 - u*u/d;
+    return u/d;
+}
 
 __kernel void render(double3 u_eye, double3 u_target, double3 u_up, double u_fov_y,
                      int u_width, int u_height, double3 u_clip_center, double u_clip_radius,
@@ -429,7 +444,7 @@ __kernel void render(double3 u_eye, double3 u_target, double3 u_up, double u_fov
     double3 forward = normalize(target - eye);
     double3 right = normalize(cross(forward, up_hint));
     double3 up = cross(right, forward);
-    double th = tan(radians(fov_y)*0.5);
+    double th = tan_half_fov(fov_y);
     double short_side = fmin(width, height);  // the shorter side spans 1
     double3 rd = normalize(forward + ndc_x*th*(width/short_side)*right
                             + ndc_y*th*(height/short_side)*up);
