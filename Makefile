@@ -123,6 +123,15 @@ forms: setup
 	$(PY) scripts/docs_section.py forms-sweep results/forms-sweep.md --write docs/RESULTS.md \
 	  --command "make forms"
 
+# exact in float32 on every float32 renderer (issue 48): wrong pixels against the certified
+# reference on gl, wgpu, cl, hlsl-spirv and Chromium's webgl2 and webgpu, Chmutov T_2..T_20
+# and the gallery's rows at 512^2, written into docs/results-float32.md. The references are
+# cached in results/reference-cache/: about 2 hours the first time, 15 minutes after.
+.PHONY: float32-renderers
+float32-renderers: setup
+	$(PY) scripts/float32_renderers.py --size 512 --degrees 2-20 --gallery \
+	  --write docs/results-float32.md
+
 # What AMD's compiler makes of the degree sweep (issue 49): RADV's ACO statistics on null
 # devices (no GPU needed) of Chmutov T_2..T_20's programs, every method, float and double,
 # written into docs/results-gpu.md, "What a GPU's compiler says" (scripts/gpu_stats_table.py). About 2 minutes.
