@@ -9,7 +9,8 @@ each method's DOUBLE_UP_TO. `make test` samples degrees
 
     IMPLC_GPU_DEGREES=2-20 pytest tests/test_gpu_stats.py
 
-The occupancy guard: exact holds at most EXACT_VGPRS VGPRs on RDNA2 from degree 13 on.
+The occupancy guard: exact holds at most EXACT_VGPRS_BELOW VGPRs on RDNA2 below degree
+13 and EXACT_VGPRS from there (Chmutov's and the bundled surfaces).
 
 Double (GLSL 450) still spills beyond DOUBLE_UP_TO: exact's walk from degree 13 on gfx1100
 (and 6 SGPRs of exact from 12 on both families), hessian's point form from 18 on gfx1100;
@@ -102,29 +103,38 @@ def test_no_method_spills(radv) -> None:
     assert not spills, "\n".join(spills)
 
 
-# exact's registers on RDNA2 in float (HLSL and GLSL 450): at most this many VGPRs from
-# degree 13 to 20 (issue 49's bound, 10 waves per SIMD). The Bernstein walk scales the
-# chord's coefficients before its Taylor shift, so a node's coefficients come out scaled:
-# scaled after it, ACO fused the scaling into the Bernstein sums and held every unscaled
+# exact's registers on RDNA2 in float (HLSL and GLSL 450), issue 49's goal: at most
+# EXACT_VGPRS_BELOW VGPRs (16 waves per SIMD) below degree EXACT_VGPRS_FROM, and
+# EXACT_VGPRS (10 waves) from there to 20. The Bernstein walk scales the chord's
+# coefficients before its Taylor shift, so a node's coefficients come out scaled: scaled
+# after it, ACO fused the scaling into the Bernstein sums and held every unscaled
 # coefficient and every power of the half width at once (112 VGPRs at degree 20, 8 waves;
-# now 88, 10). Below degree 13 the peak is the ray's coefficients (ray_of), not the walk.
+# now 88, 10). Below degree 13 the peak is the ray's coefficients (ray_of), not the walk:
+# on the tree route Chmutov's T10-T12 held 72-80 until float32's exact took them from
+# Chebyshev's basis (issue 48). Not every surface keeps the goal: Sarti's dodecic (corpus
+# row 260) holds 120, in S's gradient (docs/results-gpu.md).
 EXACT_VGPRS = 96
 EXACT_VGPRS_FROM = 13
+EXACT_VGPRS_BELOW = 64
 
 
 def test_exact_holds_few_registers(radv) -> None:
-    """exact's float programs on RDNA2 (navi21), Chmutov T_n over the sampled degrees from
-    EXACT_VGPRS_FROM (and 20): at most EXACT_VGPRS VGPRs."""
-    degrees = sorted({n for n in _degrees() if n >= EXACT_VGPRS_FROM} | {20})
-    keys, shaders = [], []
-    for n in degrees:
-        surface = implc.Surface(chmutov(n))
+    """exact's float programs on RDNA2 (navi21), Chmutov T_n over the sampled degrees (and
+    20) and the bundled surfaces: at most EXACT_VGPRS_BELOW VGPRs below degree
+    EXACT_VGPRS_FROM, EXACT_VGPRS from there."""
+    surfaces = {f"chmutov {n}": implc.Surface(chmutov(n))
+                for n in sorted(set(_degrees()) | {20})}
+    surfaces.update({name: implc.Surface.example(name) for name in BUNDLED})
+    keys, shaders, bounds = [], [], []
+    for name, surface in surfaces.items():
+        bound = EXACT_VGPRS if surface.degree >= EXACT_VGPRS_FROM else EXACT_VGPRS_BELOW
         for target, flavor, precision in PROGRAMS:
             shaders.append(surface.compile(target, "exact", flavor=flavor, precision=precision))
-            keys.append(f"chmutov {n} {target}")
+            keys.append(f"{name} {target}")
+            bounds.append(bound)
     rows = gpu_stats(shaders, ("navi21",))["navi21"]
-    over = [f"{key}: {stats.line()}" for key, stats in zip(keys, rows, strict=True)
-            if stats.vgprs > EXACT_VGPRS]
+    over = [f"{key}: {stats.line()} (at most {bound})"
+            for key, stats, bound in zip(keys, rows, bounds, strict=True) if stats.vgprs > bound]
     assert not over, "\n".join(over)
 
 
