@@ -35,22 +35,37 @@ def coefficient_program(expr: sympy.Expr, precision: str) -> Program:
     `precision`. An equation written factored keeps its factors: truncated polynomial
     arithmetic over S's own tree, jointly CSE'd. One written out at length (more than
     HORNER_ABOVE operations) takes Horner's scheme nested over x, y, z (horner_program),
-    which needs no CSE."""
+    which needs no CSE; so does one in double where the tree's registers are many
+    (coefficient_route)."""
     if polynomial_degree(expr) is None:
         raise InputError("the ray-poly form needs a polynomial surface")
-    if coefficient_route(expr) == "horner":
+    if coefficient_route(expr, precision) == "horner":
         return horner_program(expr, precision)
+    return _tree_program(expr)
+
+
+@lru_cache(maxsize=16)
+def _tree_program(expr: sympy.Expr) -> Program:
+    """The tree route's coefficients, jointly CSE'd (the same in either precision)."""
     return optimize(list(ray_coefficients(expr)), POINT + DIRECTION)
 
 
-def coefficient_route(expr: sympy.Expr) -> str:
+def coefficient_route(expr: sympy.Expr, precision: str = "float") -> str:
     """"horner" for an equation written out at length, or one whose tree route would
     write coefficients of more than TREE_ABOVE nodes (counted with repeats: what CSE
-    walks), else "tree" (see coefficient_program; `implc show` says which)."""
+    walks), or, in double, one of degree DOUBLE_HORNER_FROM or more whose Horner's
+    scheme costs at most DOUBLE_HORNER_RATIO times the tree's operations; else "tree"
+    (see coefficient_program; `implc show` says which)."""
     if count_ops(expr) > HORNER_ABOVE:
         return "horner"
     coefficients = ray_coefficients(expr) or ()
-    return "horner" if tree_size(coefficients) > TREE_ABOVE else "tree"
+    if tree_size(coefficients) > TREE_ABOVE:
+        return "horner"
+    if (precision == "double" and (polynomial_degree(expr) or 0) >= DOUBLE_HORNER_FROM
+            and _horner_plan(expr, precision)[2]
+            <= DOUBLE_HORNER_RATIO * _tree_program(expr).ops_after):
+        return "horner"
+    return "tree"
 
 
 def tree_size(exprs: Sequence[sympy.Expr]) -> int:
@@ -75,6 +90,23 @@ HORNER_ABOVE = 150
 # operations). The bundled examples' largest is Barth's decic, 4,004.
 TREE_ABOVE = 50_000
 TREE_CAP = 10**12
+# In double a value takes two registers, and the tree route's power tables (x^2..x^n,
+# dx^2..dx^n, the same for y and z) are live at once: on AMD's compiler (RADV's ACO,
+# docs/results-gpu.md) Chmutov's T10-T12 spilled 9-35 VGPRs on RDNA3 in exact, taylor and
+# hessian (navi21: 144-168 VGPRs), corpus rows 244 (degree 12) 47-51 and 358 (8) 5-7, x^18
+# + y^18 + z^18 = 1 73 (exact). Horner's scheme holds a truncated polynomial per nesting
+# level: on it none of those below degree 13 spills VGPRs (x^18 sums' exact 29, its
+# walk's), and navi21 holds 88-128 at T8-T12 (rows 49, 152, 162, 244, 358, 360 8-56
+# fewer). Where it costs far more operations than the tree (rows 51, 155, 239, 240, 247
+# and 285: 3-8x) it held more (row 247 136 -> 248, 285 128 -> 192; Barth's decic, 3.2x,
+# 128 -> 120): taken in double from DOUBLE_HORNER_FROM where it costs at most
+# DOUBLE_HORNER_RATIO times the tree's operations. On llvmpipe at 512^2 (T12's exact,
+# taylor, hessian; x^18 sums' exact) frames 0.87-1.01 of the tree's, the pictures the same
+# (one pixel's t moved by 5e-7). Not in float: exact takes Chebyshev's basis there from
+# degree 7, and float32's rounding of another route would move the other methods'
+# pictures.
+DOUBLE_HORNER_FROM = 8
+DOUBLE_HORNER_RATIO = 2
 
 
 def horner_program(expr: sympy.Expr, precision: str) -> Program:
@@ -127,7 +159,7 @@ def _horner_plan(expr: sympy.Expr, precision: str) -> tuple[dict, int, int, tupl
 def horner_ops(expr: sympy.Expr, precision: str = "float") -> int | None:
     """The operations of the ray coefficients' program where it takes Horner's route
     (None: the tree's route, never long: see TREE_ABOVE), known before it is built."""
-    if coefficient_route(expr) != "horner":
+    if coefficient_route(expr, precision) != "horner":
         return None
     return _horner_plan(expr, precision)[2]
 

@@ -124,16 +124,22 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
                     "segments)"]
     coefficients = coefficient_program(surface.expr, "float")
     if method.solves:
-        # double's program differs only where powers stand alone on Horner's route
+        # double's program differs where powers stand alone on Horner's route, and where
+        # double takes Horner's route for its registers (raypoly.DOUBLE_HORNER_FROM)
         double = coefficient_program(surface.expr, "double").ops_after
+        route = coefficient_route(surface.expr)
+        double_route = coefficient_route(surface.expr, "double")
         return [
             "",
             "exact (root isolation of the ray polynomial; no marching):",
             f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
             f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries), "
-            + ROUTES[coefficient_route(surface.expr)],
+            + ROUTES[route],
             *([f"  in double (--precision double): {double} ops (one Horner's rule a "
-               "coefficient, in o^2 where its powers share a parity)"]
+               "coefficient, in o^2 where its powers share a parity)"
+               + ("" if double_route == route else
+                  ", by Horner's scheme: the tree's power tables hold too many registers "
+                  "in double")]
               if double != coefficients.ops_after else []),
             *_solver_lines(surface.expr, degree, coefficients.ops_after,
                            surface.limits.max_derived),

@@ -3,17 +3,19 @@
 
 The guard: no method spills registers on those families in float, over the degree
 sweep's Chmutov surfaces and bundled ones, in HLSL and in GLSL 450 (a spill is scratch
-memory in the inner loop, "devastating" per Peters et al.), nor in double (GLSL 450)
-below degree 10. `make test` samples degrees
+memory in the inner loop, "devastating" per Peters et al.), nor in double (GLSL 450) up to
+each method's DOUBLE_UP_TO. `make test` samples degrees
 2, 4, 8, 12, 16, 20 (the guard ~12 s here); the whole sweep (~35 s):
 
     IMPLC_GPU_DEGREES=2-20 pytest tests/test_gpu_stats.py
 
-The occupancy guard: exact holds at most EXACT_VGPRS VGPRs on RDNA2 from degree 13 on.
+The occupancy guard: exact holds at most EXACT_VGPRS_BELOW VGPRs on RDNA2 below degree
+13 and EXACT_VGPRS from there (Chmutov's and the bundled surfaces).
 
-Double (GLSL 450) does spill from degree 10 on gfx1100 (and 6 SGPRs of exact from 12 on
-navi21); scripts/gpu_stats_table.py measures and lists it (docs/results-gpu.md, "What a
-GPU's compiler says").
+Double (GLSL 450) still spills beyond DOUBLE_UP_TO: exact's walk from degree 13 on gfx1100
+(and 6 SGPRs of exact from 12 on both families), hessian's point form from 18 on gfx1100;
+scripts/gpu_stats_table.py measures and lists it (docs/results-gpu.md, "What a GPU's
+compiler says").
 """
 
 from __future__ import annotations
@@ -37,11 +39,18 @@ BUNDLED = ("barth-decic", "barth-sextic", "clebsch")
 ROOT = Path(__file__).resolve().parent.parent
 # the float programs that reach SPIR-V: (target, flavour, precision)
 PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
-# double (GLSL 450) spills from degree 10 on gfx1100 (docs/results-gpu.md, "What a GPU's compiler
-# says"): guarded
-# below that, on the sampled degrees and the bundled sextic
+# double (GLSL 450): each method's program guarded up to this degree (on the sampled
+# degrees, 10 and 11 added, and the bundled surfaces of that degree or less). Below degree
+# 13 the peak was the tree route's power tables in ray_of, two registers a value: on gfx1100
+# exact, taylor and hessian spilled 9-35 VGPRs at T10-T12 until double took Horner's route
+# there (raypoly.DOUBLE_HORNER_FROM). exact at 12 keeps 6 spilled SGPRs (the Bernstein
+# sums' double constants, held through the walk) and from 13 its walk spills VGPRs on
+# gfx1100; hessian's point form spills from 18 there (docs/results-gpu.md).
 DOUBLE = (("glsl", "450", "double"),)
-DOUBLE_SURFACES = ("chmutov 2", "chmutov 4", "chmutov 8", "barth-sextic")
+DOUBLE_UP_TO = {"exact": 11, "taylor": 20, "hessian": 17, "interval": 20}
+DOUBLE_DEGREES = (10, 11)
+# and one known spill: Barth's decic's interval program in double spills 13 VGPRs on gfx1100
+DOUBLE_SPILLS = (("barth-decic", "interval"),)
 
 
 def _degrees() -> list[int]:
@@ -71,15 +80,20 @@ def test_the_statistics_are_acos(radv) -> None:
 
 def test_no_method_spills(radv) -> None:
     """Every method's float program, HLSL and GLSL 450, Chmutov T_n over the sampled
-    degrees and bundled surfaces, and its double program below degree 10: no spilled VGPR
-    or SGPR, no scratch, on RDNA2 and RDNA3."""
-    surfaces = {f"chmutov {n}": implc.Surface(chmutov(n)) for n in _degrees()}
-    surfaces.update({name: implc.Surface.example(name) for name in BUNDLED})
+    degrees and bundled surfaces, and its double program up to DOUBLE_UP_TO: no spilled
+    VGPR or SGPR, no scratch, on RDNA2 and RDNA3."""
+    sampled = _degrees()
+    # (name, surface, whether its float programs are guarded: not at the added degrees)
+    cases = [(f"chmutov {n}", implc.Surface(chmutov(n)), n in sampled)
+             for n in sorted(set(sampled) | set(DOUBLE_DEGREES))]
+    cases += [(name, implc.Surface.example(name), True) for name in BUNDLED]
     keys, shaders = [], []
-    for name, surface in surfaces.items():
+    for name, surface, floats in cases:
         for method in METHODS:
-            for target, flavor, precision in PROGRAMS + (
-                    DOUBLE if name in DOUBLE_SURFACES else ()):
+            programs = ((PROGRAMS if floats else ())
+                        + (DOUBLE if surface.degree <= DOUBLE_UP_TO[method]
+                           and (name, method) not in DOUBLE_SPILLS else ()))
+            for target, flavor, precision in programs:
                 shaders.append(surface.compile(target, method, flavor=flavor,
                                                precision=precision))
                 keys.append(f"{name} {method} {target} {precision}")
@@ -89,29 +103,38 @@ def test_no_method_spills(radv) -> None:
     assert not spills, "\n".join(spills)
 
 
-# exact's registers on RDNA2 in float (HLSL and GLSL 450): at most this many VGPRs from
-# degree 13 to 20 (issue 49's bound, 10 waves per SIMD). The Bernstein walk scales the
-# chord's coefficients before its Taylor shift, so a node's coefficients come out scaled:
-# scaled after it, ACO fused the scaling into the Bernstein sums and held every unscaled
+# exact's registers on RDNA2 in float (HLSL and GLSL 450), issue 49's goal: at most
+# EXACT_VGPRS_BELOW VGPRs (16 waves per SIMD) below degree EXACT_VGPRS_FROM, and
+# EXACT_VGPRS (10 waves) from there to 20. The Bernstein walk scales the chord's
+# coefficients before its Taylor shift, so a node's coefficients come out scaled: scaled
+# after it, ACO fused the scaling into the Bernstein sums and held every unscaled
 # coefficient and every power of the half width at once (112 VGPRs at degree 20, 8 waves;
-# now 88, 10). Below degree 13 the peak is the ray's coefficients (ray_of), not the walk.
+# now 88, 10). Below degree 13 the peak is the ray's coefficients (ray_of), not the walk:
+# on the tree route Chmutov's T10-T12 held 72-80 until float32's exact took them from
+# Chebyshev's basis (issue 48). Not every surface keeps the goal: Sarti's dodecic (corpus
+# row 260) holds 120, in S's gradient (docs/results-gpu.md).
 EXACT_VGPRS = 96
 EXACT_VGPRS_FROM = 13
+EXACT_VGPRS_BELOW = 64
 
 
 def test_exact_holds_few_registers(radv) -> None:
-    """exact's float programs on RDNA2 (navi21), Chmutov T_n over the sampled degrees from
-    EXACT_VGPRS_FROM (and 20): at most EXACT_VGPRS VGPRs."""
-    degrees = sorted({n for n in _degrees() if n >= EXACT_VGPRS_FROM} | {20})
-    keys, shaders = [], []
-    for n in degrees:
-        surface = implc.Surface(chmutov(n))
+    """exact's float programs on RDNA2 (navi21), Chmutov T_n over the sampled degrees (and
+    20) and the bundled surfaces: at most EXACT_VGPRS_BELOW VGPRs below degree
+    EXACT_VGPRS_FROM, EXACT_VGPRS from there."""
+    surfaces = {f"chmutov {n}": implc.Surface(chmutov(n))
+                for n in sorted(set(_degrees()) | {20})}
+    surfaces.update({name: implc.Surface.example(name) for name in BUNDLED})
+    keys, shaders, bounds = [], [], []
+    for name, surface in surfaces.items():
+        bound = EXACT_VGPRS if surface.degree >= EXACT_VGPRS_FROM else EXACT_VGPRS_BELOW
         for target, flavor, precision in PROGRAMS:
             shaders.append(surface.compile(target, "exact", flavor=flavor, precision=precision))
-            keys.append(f"chmutov {n} {target}")
+            keys.append(f"{name} {target}")
+            bounds.append(bound)
     rows = gpu_stats(shaders, ("navi21",))["navi21"]
-    over = [f"{key}: {stats.line()}" for key, stats in zip(keys, rows, strict=True)
-            if stats.vgprs > EXACT_VGPRS]
+    over = [f"{key}: {stats.line()} (at most {bound})"
+            for key, stats, bound in zip(keys, rows, bounds, strict=True) if stats.vgprs > bound]
     assert not over, "\n".join(over)
 
 
