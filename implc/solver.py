@@ -6,7 +6,7 @@ it the default method."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import comb
+from math import comb, log2
 from typing import ClassVar
 
 import sympy
@@ -190,6 +190,13 @@ def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
             printer.float_literal(4 * n * _unit_roundoff(printer)))
 
 
+def _bisections(printer, prefix: str) -> tuple[str, str, str]:
+    """BISECTIONS: the midpoints the levels' Newton takes besides its NEWTON_STEPS steps,
+    as many as halve a bracket to the precision's resolution (24 in float32, 53 in double).
+    It makes the loop's trip count unknown to the compiler (see templates/solver.j2)."""
+    return ("int", prefix.upper() + "BISECTIONS", str(-int(log2(_unit_roundoff(printer)))))
+
+
 def _touch(constants: Constants, printer) -> float:
     """TOUCH, the touching root's tolerance relative to the size of F's terms: the
     constant as measured in float32 (options.Constants.touch, far below float32's
@@ -289,13 +296,15 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         "(the reference's own: 1e-12 sum |a_k| s^k)", (("Ray", "ray"), ("real", "u")), "real",
         (), (printer.doprint(horner([sympy.Abs(ck) for ck in c], sympy.Abs(u))),)))
     K = prefix.upper()
+    bottom = 2 if n >= 3 else 1
     printed = (("real", K + "TOUCH", printer.float_literal(_touch(constants, printer))),
                *(() if bernstein else (_round_err(n, printer, prefix),)),
+               *((_bisections(printer, prefix),) if not bernstein and root_levels(n, bottom)
+                 else ()),
                ("real", K + "XTOL", printer.float_literal(constants.xtol)),
                ("real", K + "CTOL", printer.float_literal(constants.ctol)),
                ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))),
                ("int", K + "CRIT_STEPS", str(int(constants.crit_steps))))
-    bottom = 2 if n >= 3 else 1
     m = n - bottom
     closed = tuple(printer.doprint(v) for v in derivative_coefficients(n, m))
     solver = Solver(n, bottom, closed)
@@ -328,6 +337,13 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Solving("ray-poly", tuple(functions), printed, ray_fields, ray, carried, solver)
+
+
+def root_levels(n: int, bottom: int) -> range:
+    """The levels k whose roots templates/solver.j2 finds by a function root<k> (the levels
+    strategy): above the closed-form one, up to n (F's pieces), or up to n - 2 where the
+    levels n - 1 and n are solved in trace's one Newton loop (lazy: from degree 4)."""
+    return range(bottom + 1, n - 1 if n - 1 > bottom else n + 1)
 
 
 def descent_levels(n: int) -> tuple[tuple[int, tuple[int, ...]], ...]:
