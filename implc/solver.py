@@ -56,6 +56,17 @@ BERNSTEIN_FROM = 5
 # 0.54 of taylor); at degree 9 (corpus row 163) it cost 15 % a frame for 1 pixel.
 ROBUST_NEWTON_BELOW = 7
 
+# The levels' F (P_n) is Estrin's value where its sign is certain, else S at the point,
+# from this degree; below it S at the point alone (as the Bernstein walk's): a degree-2 or
+# 3 program evaluates F at its few piece ends and Newton's iterates, and llvmpipe (as a
+# SIMD group with lanes on both sides) computes both sides of the select, so Estrin's value
+# only added its operations. Measured at 1024^2 on llvmpipe (CPU time, 2 compiled copies,
+# 15 rounds, medians): frames 0.96-0.99 of the select's on Cayley's, Clebsch's and the
+# ding-dong cubics, the Whitney umbrella and corpus row 48, the same false / missed /
+# wrong-root counts at 512^2 on those and corpus rows 4, 17, 29, 59, 77, 192, 212, 218
+# and 251 (docs/results-gpu.md). Degree 4 (the levels' lazy loop) is not measured here.
+ESTRIN_FIRST_FROM = 4
+
 # Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its
 # middle is a touching root when |F| there is within TOUCH), and a ray visits at most 96
 # nodes (measured at 192^2 on the sweep's degree 8, 13 and 16 surfaces: 1.6-5.6 a ray on
@@ -280,16 +291,17 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
             f"P{k}", f"P{k} = {what}, degree {k} in u = t - sm",
             (("Ray", "ray"), ("real", "u")), "real", tuple(printed_lets(powers, printer)),
             (printer.doprint(value),)))
-    # F itself, whose sign is the answer: for the levels, Estrin where that sign is certain,
-    # else at the point (see RAY_DERIVATIVES); for the Bernstein walk, at the point alone.
+    # F itself, whose sign is the answer: for the levels from ESTRIN_FIRST_FROM, Estrin where
+    # that sign is certain, else at the point (see RAY_DERIVATIVES); below it and for the
+    # Bernstein walk, at the point alone.
     # llvmpipe computes both sides of the select (as does a SIMD group with lanes on both),
     # so there Estrin's value only added its operations to every node's end: measured at
     # 512^2, exact / taylor 2-10 % lower (x^18 sums 0.73 -> 0.68, Chmutov T18 1.24 ->
     # 1.11, T12 0.72 -> 0.71, corpus rows 137 0.44 -> 0.41 and 244 0.57 -> 0.54), and the
     # same false / missed / wrong-root counts on T12, x^12 sums and rows 137, 163, 244,
     # 247 and 285 (docs/journal/2026-12-03.md)
-    functions.append(_value_function(f"P{n}", n, printer, prefix, carried,
-                                     certain_first=not bernstein))
+    certain_first = not bernstein and n >= ESTRIN_FIRST_FROM
+    functions.append(_value_function(f"P{n}", n, printer, prefix, carried, certain_first))
     c = [sym(f"ray.c{k}") for k in range(n + 1)]
     functions.append(ShaderFunction(
         "scale_at", "sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit "
@@ -298,7 +310,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     K = prefix.upper()
     bottom = 2 if n >= 3 else 1
     printed = (("real", K + "TOUCH", printer.float_literal(_touch(constants, printer))),
-               *(() if bernstein else (_round_err(n, printer, prefix),)),
+               *((_round_err(n, printer, prefix),) if certain_first else ()),
                *((_bisections(printer, prefix),) if not bernstein and root_levels(n, bottom)
                  else ()),
                ("real", K + "XTOL", printer.float_literal(constants.xtol)),

@@ -128,12 +128,13 @@ def test_solver_baseline_does_not_spill():
 
 
 def test_exact_cubic_is_no_longer_than_the_solver_baseline():
-    """exact's degree-3 program on RDNA2 (navi21, GLSL 450) is at most 1.25x the
+    """exact's degree-3 program on RDNA2 (navi21, GLSL 450) is at most 1.15x the
     instructions of Yuksel's port on the same surface, where S is light enough for the
     compiler to unroll a short loop. The levels' Newton is capped by its count of Newton
     steps (templates/solver.j2), not by a trip count of 12, which Mesa's compiler unrolled
     (the Whitney umbrella 995 instructions against the port's 373), and F's pieces are
-    walked by a loop, not one block a piece (493 with the blocks; now 433)."""
+    walked by a loop, not one block a piece (493 with the blocks, 433 without), and F is S
+    at the point alone, not Estrin's value where its sign is certain (now 411)."""
     require_tool("glslangValidator")
     if problem := radv_problem():
         _require("Mesa's RADV", problem)
@@ -146,4 +147,4 @@ def test_exact_cubic_is_no_longer_than_the_solver_baseline():
     stats = gpu_stats(shaders, ["navi21"])["navi21"]
     for name, exact, port in zip(("whitney-umbrella", "ding-dong"), stats[::2], stats[1::2],
                                  strict=True):
-        assert exact.instructions <= 1.25 * port.instructions, (name, exact.line(), port.line())
+        assert exact.instructions <= 1.15 * port.instructions, (name, exact.line(), port.line())
