@@ -132,7 +132,7 @@ def test_exact_cubic_is_no_longer_than_the_solver_baseline():
     instructions of Yuksel's port on the same surface, where S is light enough for the
     compiler to unroll a short loop. The levels' Newton is capped by its count of Newton
     steps (templates/solver.j2), not by a trip count of 12, which Mesa's compiler unrolled
-    (the Whitney umbrella 995 instructions against the port's 373), and F's pieces are
+    (the Whitney umbrella 980 instructions against the port's 373), and F's pieces are
     walked by a loop, not one block a piece (493 with the blocks, 433 without), and F is S
     at the point alone, not Estrin's value where its sign is certain (now 411)."""
     require_tool("glslangValidator")
