@@ -311,7 +311,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     bottom = 2 if n >= 3 else 1
     printed = (("real", K + "TOUCH", printer.float_literal(_touch(constants, printer))),
                *((_round_err(n, printer, prefix),) if certain_first else ()),
-               *((_bisections(printer, prefix),) if not bernstein and root_levels(n, bottom)
+               *((_bisections(printer, prefix),) if bernstein or root_levels(n, bottom)
                  else ()),
                ("real", K + "XTOL", printer.float_literal(constants.xtol)),
                ("real", K + "CTOL", printer.float_literal(constants.ctol)),
