@@ -6,7 +6,7 @@ it the default method."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import comb
+from math import comb, log2
 from typing import ClassVar
 
 import sympy
@@ -55,6 +55,17 @@ BERNSTEIN_FROM = 5
 # their place, the robust one 8, and Barth's sextic ran faster with it (0.44 against
 # 0.54 of taylor); at degree 9 (corpus row 163) it cost 15 % a frame for 1 pixel.
 ROBUST_NEWTON_BELOW = 7
+
+# The levels' F (P_n) is Estrin's value where its sign is certain, else S at the point,
+# from this degree; below it S at the point alone (as the Bernstein walk's): a degree-2 or
+# 3 program evaluates F at its few piece ends and Newton's iterates, and llvmpipe (as a
+# SIMD group with lanes on both sides) computes both sides of the select, so Estrin's value
+# only added its operations. Measured at 1024^2 on llvmpipe (CPU time, 2 compiled copies,
+# 15 rounds, medians): frames 0.96-0.99 of the select's on Cayley's, Clebsch's and the
+# ding-dong cubics, the Whitney umbrella and corpus row 48, the same false / missed /
+# wrong-root counts at 512^2 on those and corpus rows 4, 17, 29, 59, 77, 192, 212, 218
+# and 251 (docs/results-gpu.md). Degree 4 (the levels' lazy loop) is not measured here.
+ESTRIN_FIRST_FROM = 4
 
 # Bernstein subdivision's bounds: a node narrower than 2^-14 of the chord is a leaf (its
 # middle is a touching root when |F| there is within TOUCH), and a ray visits at most 96
@@ -190,6 +201,13 @@ def _round_err(n: int, printer, prefix: str) -> tuple[str, str, str]:
             printer.float_literal(4 * n * _unit_roundoff(printer)))
 
 
+def _bisections(printer, prefix: str) -> tuple[str, str, str]:
+    """BISECTIONS: the midpoints the levels' Newton takes besides its NEWTON_STEPS steps,
+    as many as halve a bracket to the precision's resolution (24 in float32, 53 in double).
+    It makes the loop's trip count unknown to the compiler (see templates/solver.j2)."""
+    return ("int", prefix.upper() + "BISECTIONS", str(-int(log2(_unit_roundoff(printer)))))
+
+
 def _touch(constants: Constants, printer) -> float:
     """TOUCH, the touching root's tolerance relative to the size of F's terms: the
     constant as measured in float32 (options.Constants.touch, far below float32's
@@ -273,29 +291,32 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
             f"P{k}", f"P{k} = {what}, degree {k} in u = t - sm",
             (("Ray", "ray"), ("real", "u")), "real", tuple(printed_lets(powers, printer)),
             (printer.doprint(value),)))
-    # F itself, whose sign is the answer: for the levels, Estrin where that sign is certain,
-    # else at the point (see RAY_DERIVATIVES); for the Bernstein walk, at the point alone.
+    # F itself, whose sign is the answer: for the levels from ESTRIN_FIRST_FROM, Estrin where
+    # that sign is certain, else at the point (see RAY_DERIVATIVES); below it and for the
+    # Bernstein walk, at the point alone.
     # llvmpipe computes both sides of the select (as does a SIMD group with lanes on both),
     # so there Estrin's value only added its operations to every node's end: measured at
     # 512^2, exact / taylor 2-10 % lower (x^18 sums 0.73 -> 0.68, Chmutov T18 1.24 ->
     # 1.11, T12 0.72 -> 0.71, corpus rows 137 0.44 -> 0.41 and 244 0.57 -> 0.54), and the
     # same false / missed / wrong-root counts on T12, x^12 sums and rows 137, 163, 244,
     # 247 and 285 (docs/journal/2026-12-03.md)
-    functions.append(_value_function(f"P{n}", n, printer, prefix, carried,
-                                     certain_first=not bernstein))
+    certain_first = not bernstein and n >= ESTRIN_FIRST_FROM
+    functions.append(_value_function(f"P{n}", n, printer, prefix, carried, certain_first))
     c = [sym(f"ray.c{k}") for k in range(n + 1)]
     functions.append(ShaderFunction(
         "scale_at", "sum |c_k| |u|^k: the size of F's terms at u, the touch tolerance's unit "
         "(the reference's own: 1e-12 sum |a_k| s^k)", (("Ray", "ray"), ("real", "u")), "real",
         (), (printer.doprint(horner([sympy.Abs(ck) for ck in c], sympy.Abs(u))),)))
     K = prefix.upper()
+    bottom = 2 if n >= 3 else 1
     printed = (("real", K + "TOUCH", printer.float_literal(_touch(constants, printer))),
-               *(() if bernstein else (_round_err(n, printer, prefix),)),
+               *((_round_err(n, printer, prefix),) if certain_first else ()),
+               *((_bisections(printer, prefix),) if bernstein or root_levels(n, bottom)
+                 else ()),
                ("real", K + "XTOL", printer.float_literal(constants.xtol)),
                ("real", K + "CTOL", printer.float_literal(constants.ctol)),
                ("int", K + "NEWTON_STEPS", str(int(constants.newton_steps))),
                ("int", K + "CRIT_STEPS", str(int(constants.crit_steps))))
-    bottom = 2 if n >= 3 else 1
     m = n - bottom
     closed = tuple(printer.doprint(v) for v in derivative_coefficients(n, m))
     solver = Solver(n, bottom, closed)
@@ -328,6 +349,13 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Solving("ray-poly", tuple(functions), printed, ray_fields, ray, carried, solver)
+
+
+def root_levels(n: int, bottom: int) -> range:
+    """The levels k whose roots templates/solver.j2 finds by a function root<k> (the levels
+    strategy): above the closed-form one, up to n (F's pieces), or up to n - 2 where the
+    levels n - 1 and n are solved in trace's one Newton loop (lazy: from degree 4)."""
+    return range(bottom + 1, n - 1 if n - 1 > bottom else n + 1)
 
 
 def descent_levels(n: int) -> tuple[tuple[int, tuple[int, ...]], ...]:

@@ -11,6 +11,7 @@ surface's double lines, whose first roots are known in closed form.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -353,3 +354,26 @@ def test_a_polynomial_too_long_for_exact_defaults_to_the_interval_walk():
     assert horner_ops(expr) > EXACT_DEFAULT_MAX_OPS
     assert default_method(expr) == "interval"
     assert default_method(load_surface(equation=chmutov(18)).expr) == "exact"
+
+
+# Mesa's loop unrolling takes loops of at most this many iterations (max_unroll_iterations)
+MESA_UNROLL_LIMIT = 32
+
+
+@pytest.mark.parametrize("equation", ["x^2+y^2+z^2=1", "x^2-y^2*z=0", "x^6+y^6+z^6=1",
+                                      "(x^2+9/4*y^2+z^2-1)^3-x^2*z^3-9/80*y^2*z^3=0"])
+def test_newton_loops_are_not_unrolled(equation):
+    """exact's Newton loops (degree 2 and 3: the levels' root; from 5: after the walk) count
+    their Newton steps instead of having NEWTON_STEPS as their trip count, so that their
+    trip count is more than Mesa unrolls: unrolled where S is light, llvmpipe ran every
+    step for every pixel (1024^2, CPU time: the umbrella's frame 55 -> 35 ms; x^6 sums and
+    Taubin's heart 1.26-1.30x slower unrolled) and ACO printed 980 instructions for the
+    umbrella's program instead of 493."""
+    text = emit(load_surface(equation=equation), "glsl", "exact", METHODS["exact"].defaults)
+    constants = dict(re.findall(r"const int (\w+) = (\d+);", text))
+    bounds = re.findall(r"for \(int i = 0; i < ([^;]+);[^{]*\{(?:(?!\n    \}\n).)*?newton \+= 1",
+                        text, flags=re.S)
+    assert bounds, "no Newton loop counting its steps"
+    for bound in bounds:
+        value = sum(int(constants.get(term.strip(), term.strip())) for term in bound.split("+"))
+        assert value > MESA_UNROLL_LIMIT, bound
