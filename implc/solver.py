@@ -113,6 +113,22 @@ FIRST_HALVINGS = 3
 # coefficients hold the root and nothing follows Estrin's Newton (programs unchanged).
 POLISH_STEPS = 2
 
+# Where the ray's coefficients come from S in Chebyshev's basis (float32 from
+# ROBUST_NEWTON_BELOW, implc/chebyshev.py), a node the walk would skip is decided again
+# on F re-expanded about its own middle (ray_of called there) when an inner Bernstein
+# coefficient is within RECENTER_TOL of the size of F's terms on the node and the
+# expansion's middle lies outside the node: the power series about one point of the chord
+# rounds to a share of its terms there (up to (1 + sqrt 2)^n times F's size at T_n), and
+# a skipped root pair is a first root missed. The first expansion is about RECENTER_AT of
+# the chord, the first node's middle. Measured on gl at 256^2 against the certified
+# reference (bad pixels, share of the pixels that re-expand; scratch text patches of the
+# float32 program, docs/journal/2026-12-05-float32.md): Chmutov T16 36 -> 6 (9 %), T18
+# 208 -> 21 (14 %), T20 1,158 -> 58 (18 %); 1e-4 instead: T20 94 with 45 % re-expanding
+# about the chord's middle; also re-expanding a root node in doubt: T20 15, 65 %, 1.3x a
+# frame.
+RECENTER_TOL = 1e-5
+RECENTER_AT = 0.25
+
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
@@ -165,6 +181,10 @@ class Solver:
     # bernstein, Newton on Estrin's value in float32: the Newton steps on F's robust value
     # after it (POLISH_STEPS; 0: none)
     polish: int = 0
+    # bernstein, ray's coefficients from Chebyshev's basis: RECENTER_TOL and RECENTER_AT
+    # printed ("": F is expanded once, about the chord's middle)
+    recenter_tol: str = ""
+    recenter_at: str = ""
 
 
 @dataclass(frozen=True)
@@ -318,13 +338,18 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS,
                         printer.float_literal(FIRST_REACH), FIRST_HALVINGS,
                         POLISH_STEPS if not robust_newton and printer.precision == "float"
-                        else 0)
+                        else 0,
+                        *((printer.float_literal(RECENTER_TOL),
+                           printer.float_literal(RECENTER_AT)) if chebyshev is not None
+                          else ()))
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
                 "Fh", "F at u by Estrin's scheme alone: the Newton loop's value, inside a "
                 f"bracket whose ends P{n} confirmed", (("Ray", "ray"), ("real", "u")), "real",
                 tuple(printed_lets(powers, printer)), (printer.doprint(value),)))
+        if chebyshev is not None:
+            printed += (("real", K + "RECENTER_TOL", solver.recenter_tol),)
         printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Solving("ray-poly", tuple(functions), printed, ray_fields, ray, carried, solver)
