@@ -121,12 +121,13 @@ POLISH_STEPS = 2
 # rounds to a share of its terms there (up to (1 + sqrt 2)^n times F's size at T_n), and
 # a skipped root pair is a first root missed. The first expansion is about RECENTER_AT of
 # the chord, the first node's middle. Measured on gl at 256^2 against the certified
-# reference (bad pixels, share of the pixels that re-expand; scratch text patches of the
-# float32 program, docs/journal/2026-12-05-float32.md): Chmutov T16 36 -> 6 (9 %), T18
-# 208 -> 21 (14 %), T20 1,158 -> 58 (18 %); 1e-4 instead: T20 94 with 45 % re-expanding
-# about the chord's middle; also re-expanding a root node in doubt: T20 15, 65 %, 1.3x a
-# frame.
-RECENTER_TOL = 1e-5
+# reference (bad pixels; docs/journal/2026-12-05-float32.md): Chmutov T16 36 -> 1, T18
+# 208 -> 6, T20 1,158 -> 20; with 1e-5 6, 21, 58 at about the same frame, with 1e-3
+# T18 2, T20 3 at 1.05-1.2x it. Each re-expansion is a ray_of (1,151-1,333 operations at
+# T16-T18) paid by the SIMD group of any lane that needs it: exact / taylor at 512^2
+# 0.65 -> 0.84 at T16, 0.80 -> 0.92 at T18, 0.66 at T20. Re-expanding a root node in
+# doubt as well (about the chord's middle): T20 15, 1.3x a frame.
+RECENTER_TOL = 1e-4
 RECENTER_AT = 0.25
 
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
