@@ -124,6 +124,29 @@ FIRST_HALVINGS = 3
 # coefficients hold the root and nothing follows Estrin's Newton (programs unchanged).
 POLISH_STEPS = 2
 
+# Where the ray's coefficients come from S in Chebyshev's basis (float32 from
+# ROBUST_NEWTON_BELOW, implc/chebyshev.py), a node the walk would skip is decided again
+# on F re-expanded about its own middle (ray_of called there) when an inner Bernstein
+# coefficient is within RECENTER_TOL of the size of F's terms on the node and the
+# expansion's middle lies outside the node: the power series about one point of the chord
+# rounds to a share of its terms there (up to (1 + sqrt 2)^n times F's size at T_n), and
+# a skipped root pair is a first root missed. The first expansion is about RECENTER_AT of
+# the chord, the first node's middle. Measured on gl at 256^2 against the certified
+# reference (bad pixels; docs/journal/2026-12-05-float32.md): Chmutov T16 36 -> 1, T18
+# 208 -> 6, T20 1,158 -> 20; with 1e-5 6, 21, 58 at about the same frame, with 1e-3
+# T18 2, T20 3 at 1.05-1.2x it. Each re-expansion is a ray_of (1,151-1,333 operations at
+# T16-T18) paid by the SIMD group of any lane that needs it: exact / taylor at 512^2
+# T16 0.70 -> 0.89, T17 0.71 -> 0.89, T18 0.77 -> 0.91, T19 0.75 -> 0.85, T20 0.67 ->
+# 0.66 (over issue 48's 0.67). Re-expanding a root node in doubt as well (about the
+# chord's middle): T20 15, 1.3x a frame.
+RECENTER_TOL = 1e-4
+RECENTER_AT = 0.25
+# ... from this degree: below it one expansion about the chord's middle was right on gl
+# and wgpu (T7-T13: 0-2 bad pixels of 65,536 at 256^2; T14 4-7 and T15 9-15 were not)
+# and the re-expansion cost 10-30 % a frame at T8-T13 (exact / taylor 0.47-0.60 ->
+# 0.56-0.72)
+RECENTER_FROM = 14
+
 # EXACT_MAX_DEGREE, the exact method's highest degree (and why), is in implc/options.py
 
 
@@ -176,6 +199,10 @@ class Solver:
     # bernstein, Newton on Estrin's value in float32: the Newton steps on F's robust value
     # after it (POLISH_STEPS; 0: none)
     polish: int = 0
+    # bernstein, ray's coefficients from Chebyshev's basis: RECENTER_TOL and RECENTER_AT
+    # printed ("": F is expanded once, about the chord's middle)
+    recenter_tol: str = ""
+    recenter_at: str = ""
 
 
 @dataclass(frozen=True)
@@ -331,6 +358,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         # Newton and two polishing steps, 22, 115, 740 with Newton on S, at about the
         # same frame: 0.74 -> 0.65, 0.83 -> 0.79, 0.67 -> 0.71 of taylor's)
         robust_newton = n < ROBUST_NEWTON_BELOW or chebyshev is not None
+        recenter = chebyshev is not None and n >= RECENTER_FROM
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
                         control_w, printer.float_literal(2 / n), robust_newton,
                         tuple((level, printer.float_literal(0.5 ** level), pairs)
@@ -339,13 +367,18 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS,
                         printer.float_literal(FIRST_REACH), FIRST_HALVINGS,
                         POLISH_STEPS if not robust_newton and printer.precision == "float"
-                        else 0)
+                        else 0,
+                        *((printer.float_literal(RECENTER_TOL),
+                           printer.float_literal(RECENTER_AT)) if recenter
+                          else ()))
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
                 "Fh", "F at u by Estrin's scheme alone: the Newton loop's value, inside a "
                 f"bracket whose ends P{n} confirmed", (("Ray", "ray"), ("real", "u")), "real",
                 tuple(printed_lets(powers, printer)), (printer.doprint(value),)))
+        if recenter:
+            printed += (("real", K + "RECENTER_TOL", solver.recenter_tol),)
         printed += (("int", K + "MAX_NODES", str(BERNSTEIN_MAX_NODES)),
                     ("real", K + "MIN_WIDTH", printer.float_literal(2.0 ** -BERNSTEIN_DEPTH)))
     return Solving("ray-poly", tuple(functions), printed, ray_fields, ray, carried, solver)
