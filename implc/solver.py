@@ -124,23 +124,27 @@ FIRST_HALVINGS = 3
 # coefficients hold the root and nothing follows Estrin's Newton (programs unchanged).
 POLISH_STEPS = 2
 
-# Where the ray's coefficients come from S in Chebyshev's basis (float32 from
-# ROBUST_NEWTON_BELOW, implc/chebyshev.py), a node the walk would skip is decided again
-# on F re-expanded about its own middle (ray_of called there) when an inner Bernstein
-# coefficient is within RECENTER_TOL of the size of F's terms on the node and the
-# expansion's middle lies outside the node: the power series about one point of the chord
-# rounds to a share of its terms there (up to (1 + sqrt 2)^n times F's size at T_n), and
-# a skipped root pair is a first root missed. The first expansion is about RECENTER_AT of
-# the chord, the first node's middle. Measured on gl at 256^2 against the certified
-# reference (bad pixels; docs/journal/2026-12-05-float32.md): Chmutov T16 36 -> 1, T18
-# 208 -> 6, T20 1,158 -> 20; with 1e-5 6, 21, 58 at about the same frame, with 1e-3
-# T18 2, T20 3 at 1.05-1.2x it. Each re-expansion is a ray_of (1,151-1,333 operations at
-# T16-T18) paid by the SIMD group of any lane that needs it: exact / taylor at 512^2
-# T16 0.70 -> 0.89, T17 0.71 -> 0.89, T18 0.77 -> 0.91, T19 0.75 -> 0.85, T20 0.67 ->
-# 0.66 (over issue 48's 0.67). Re-expanding a root node in doubt as well (about the
-# chord's middle): T20 15, 1.3x a frame.
+# Where the ray's coefficients come from S in Chebyshev's basis (float32 from ROBUST_NEWTON_BELOW,
+# implc/chebyshev.py), a node the walk would skip is decided again on F re-expanded about its own
+# middle (ray_of called there) when an inner Bernstein coefficient is within RECENTER_TOL of the
+# size of F's terms on the node and the expansion's middle lies outside the node: the power series
+# about one point of the chord rounds to a share of its terms there (up to (1 + sqrt 2)^n times F's
+# size at T_n), and a skipped root pair is a first root missed. The first expansion is about
+# RECENTER_AT of the chord. Measured on gl at 256^2 against the certified reference, with the first
+# expansion about the first node's middle (bad pixels; docs/journal/2026-12-05-float32.md): Chmutov
+# T16 36 -> 1, T18 208 -> 6, T20 1,158 -> 20; with 1e-5 6, 21, 58 at about the same frame, with 1e-3
+# T18 2, T20 3 at 1.05-1.2x it. Each re-expansion is a ray_of (1,151-1,333 operations at T16-T18)
+# paid by the SIMD group of any lane that needs it: exact / taylor at 512^2 T16 0.70 -> 0.89, T17
+# 0.71 -> 0.89, T18 0.77 -> 0.91, T19 0.75 -> 0.85, T20 0.67 -> 0.66 (over issue 48's 0.67). Re-
+# expanding a root node in doubt as well (about the chord's middle): T20 15, 1.3x a frame.
 RECENTER_TOL = 1e-4
-RECENTER_AT = 0.25
+# The first expansion's centre, a share of the chord. At 512^2 on gl (bad pixels at
+# T14-T20, against the certified reference): 0.5 (the middle) 0, 1, 0, 19, 39, 62, 41;
+# 0.25 (the first node's middle) 2, 41, 33, 132, 35, 11, 26; 0.375 and 0.45 between
+# them. The middle has the fewest in all and is within issue 48's 0.01 % (26) to T17;
+# with a node re-expanded also where the centre is at its end (|nm| >= nr), worse at
+# both (T17 151 and 150).
+RECENTER_AT = 0.5
 # ... from this degree: below it one expansion about the chord's middle was right on gl
 # and wgpu (T7-T13: 0-2 bad pixels of 65,536 at 256^2; T14 4-7 and T15 9-15 were not)
 # and the re-expansion cost 10-30 % a frame at T8-T13 (exact / taylor 0.47-0.60 ->
