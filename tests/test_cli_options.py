@@ -105,9 +105,9 @@ BAD_OPTIONS = [
     (["render", "sphere", "--size", "16", "--width", "16", "-o", "OUT/a.png"],
      "give --size or --width/--height, not both"),
     (["render", "sphere", "-t", "wgsl", "-b", "gl", "-o", "OUT/a.png"],
-     "-t wgsl renders with -b wgpu, not -b gl"),
+     "-t wgsl renders with -b wgpu or webgpu, not -b gl"),
     (["render", "sphere", "-t", "glsl", "-b", "reference", "-o", "OUT/a.png"],
-     "-t glsl renders with -b gl or gl-double, not -b reference"),
+     "-t glsl renders with -b gl or gl-double or webgl2, not -b reference"),
     (["render", "sphere", "--flavor", "shadertoy", "-o", "OUT/a.png"],
      "--flavor shadertoy: -b gl renders the 330 program; the other flavours are for "
      "`implc compile`"),

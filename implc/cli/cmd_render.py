@@ -105,9 +105,10 @@ def _backend(args: argparse.Namespace) -> str:
     if target is not None and args.flavor is not None:
         if problem := flavor_problem(target, args.flavor):
             raise UsageError(f"--flavor: {problem}")
-        if args.flavor != target.default_flavor:  # the program every backend runs
+        runs = BACKENDS[backend].flavor or target.default_flavor
+        if args.flavor != runs:  # the program the backend runs
             raise UsageError(f"--flavor {args.flavor}: -b {backend} renders the "
-                             f"{target.default_flavor} program; the other flavours are for "
+                             f"{runs} program; the other flavours are for "
                              "`implc compile`")
     return backend
 

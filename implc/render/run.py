@@ -115,17 +115,25 @@ def backend_target(backend: str) -> Target:
 
 
 def backend_for(backend: str, precision: str | None) -> str:
-    """The backend of `backend`'s target that runs its program at `precision`
-    (`-b cl --precision double` is `cl-double`); `precision` None keeps `backend`."""
+    """The backend with `backend`'s runner that runs its program at `precision` (`-b cl
+    --precision double` is `cl-double`; `webgl2` has no double); `precision` None keeps
+    `backend`."""
     if precision is None or (backend == REFERENCE and precision == "float"):
         return backend
-    for target in TARGETS.values():
-        if backend in target.backends:
-            for name, other in target.backends.items():
-                if other.precision == precision:
-                    return name
-    able = [name for t in TARGETS.values() if precision in t.precisions for name in t.backends]
+    for name in _siblings(backend):
+        if BACKENDS[name].precision == precision:
+            return name
+    able = [name for name in BACKENDS
+            if any(BACKENDS[s].precision == precision for s in _siblings(name))]
     raise InputError(f"--precision {precision} renders with -b {' or '.join(able)} only")
+
+
+def _siblings(backend: str) -> list[str]:
+    """The backends that share `backend`'s runner (one per precision), itself first."""
+    if backend not in BACKENDS:
+        return []
+    runner = BACKENDS[backend].runner
+    return [backend] + [n for n, b in BACKENDS.items() if b.runner == runner and n != backend]
 
 
 def render(
