@@ -82,15 +82,25 @@ TIMEOUT_MS = 300_000  # SwiftShader on shared cores: a compile or a frame can ta
 def page(name: str, html: str):
     """The page `name` (its text `html`, written to a temporary file and opened), once per
     browser: the float32 probe's, the render backends'."""
+    opened = browser()  # before the pages: a first browser() starts from no state
     pages = _state.setdefault("pages", {})
     assert isinstance(pages, dict)
     if name not in pages:
-        opened = browser().new_page()  # first: browser() may reset the state
-        pages = _state.setdefault("pages", {})
-        assert isinstance(pages, dict)
+        tab = opened.new_page()
         page_file = Path(tempfile.mkdtemp(prefix=f"implc-{name}-")) / f"{name}.html"
         page_file.write_text(html, encoding="utf-8")
-        opened.set_default_timeout(TIMEOUT_MS)
-        opened.goto(page_file.as_uri())
-        pages[name] = opened
+        tab.set_default_timeout(TIMEOUT_MS)
+        tab.goto(page_file.as_uri())
+        pages[name] = tab
     return pages[name]
+
+
+def evaluate(tab, script: str, *args):
+    """`script` called with `args` in the page `tab`; a JavaScript exception (no WebGL2,
+    no adapter, a compile error) becomes a ToolError carrying its first line."""
+    try:
+        return tab.evaluate(script, list(args))
+    except ToolError:
+        raise
+    except Exception as err:  # playwright's Error
+        raise ToolError(f"chromium: {str(err).strip().splitlines()[0]}") from err

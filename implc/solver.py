@@ -143,7 +143,8 @@ RECENTER_TOL = 1e-4
 # 0.25 (the first node's middle) 2, 41, 33, 132, 35, 11, 26; 0.375 and 0.45 between
 # them. The middle has the fewest in all and is within issue 48's 0.01 % (26) to T17;
 # with a node re-expanded also where the centre is at its end (|nm| >= nr), worse at
-# both (T17 151 and 150).
+# both (T17 151 and 150). It costs more: exact / taylor at 512^2 T16-T19 0.88, 0.98,
+# 1.05, 1.02 against 0.84, 0.91, 0.98, 0.91 in the same run (docs/results-float32.md).
 RECENTER_AT = 0.5
 # ... from this degree: below it one expansion about the chord's middle was right on gl
 # and wgpu (T7-T13: 0-2 bad pixels of 65,536 at 256^2; T14 4-7 and T15 9-15 were not)

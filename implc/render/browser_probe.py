@@ -9,9 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..chromium import page, use_browser
+from ..chromium import evaluate, page, use_browser
 from ..emit import render_template
-from ..errors import ToolError
 
 __all__ = ["browser_driver", "run_webgl2", "run_webgpu", "use_browser"]
 
@@ -21,12 +20,7 @@ def _page():
 
 
 def _call(script: str, *args) -> list:
-    try:
-        return _page().evaluate(script, list(args))
-    except ToolError:
-        raise
-    except Exception as err:  # a JS exception: no WebGL2, no adapter, a compile error
-        raise ToolError(f"chromium: {str(err).splitlines()[0]}") from err
+    return evaluate(_page(), script, *args)
 
 
 def _pairs(bits: list, count: int) -> np.ndarray:

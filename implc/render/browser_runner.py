@@ -16,10 +16,10 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..chromium import page
+from ..chromium import evaluate, page
 from ..emit import CompiledShader, ParamUniform, render_template
-from ..errors import ToolError
 from ..scene import View
+from .gl import camera_uniforms
 from .result import RenderResult, TimedRunner
 from .wgpu_runner import uniform_block
 
@@ -31,12 +31,7 @@ def _page():
 
 
 def _call(script: str, *args):
-    try:
-        return _page().evaluate(script, list(args))
-    except ToolError:
-        raise
-    except Exception as err:  # a JS exception: no WebGL2/WebGPU, a compile error
-        raise ToolError(f"chromium: {str(err).strip()}") from err
+    return evaluate(_page(), script, *args)
 
 
 def _decode(text: str, width: int, height: int) -> np.ndarray:
@@ -68,13 +63,12 @@ class WebGL2Runner(BrowserRunner):
         super().__init__(width, height)
         vertex = render_template("glsl/fullscreen.vert.j2", version="300 es")
         self.params = {p.name: p.uniform for p in params}
-        uniforms = {"u_resolution": [width, height], "u_eye": view.eye,
-                    "u_target": view.target, "u_up": view.up, "u_fov_y": [view.fov_y_deg],
-                    "u_clip_center": view.clip_center, "u_clip_radius": [view.clip_radius],
-                    **{p.uniform: [p.value] for p in params}}
+        uniforms = {**camera_uniforms(view, width, height),
+                    **{p.uniform: p.value for p in params}}
         self.driver = _call("([id, v, f, w, h, u]) => implcRender.webgl2(id, v, f, w, h, u)",
                             self.id, vertex, fragment, width, height,
-                            {k: [float(x) for x in v] for k, v in uniforms.items()})
+                            {k: [float(x) for x in np.atleast_1d(v)]
+                             for k, v in uniforms.items()})
 
     def set_params(self, values: Mapping[str, float]) -> None:
         _call("([id, u]) => implcRender.set(id, u)", self.id,

@@ -50,6 +50,19 @@ def renderer_name() -> str:
     return str(context().info.get("GL_RENDERER", "unknown"))
 
 
+def camera_uniforms(view: View, width: int, height: int) -> dict[str, object]:
+    """The GLSL programs' camera uniforms (docs/reference/drop-ins.md), by name."""
+    return {
+        "u_resolution": (float(width), float(height)),
+        "u_eye": view.eye,
+        "u_target": view.target,
+        "u_up": view.up,
+        "u_fov_y": view.fov_y_deg,
+        "u_clip_center": view.clip_center,
+        "u_clip_radius": view.clip_radius,
+    }
+
+
 class GlRunner(TimedRunner):
     """A compiled program and its framebuffer; `frame()` renders and reads back once."""
 
@@ -66,16 +79,7 @@ class GlRunner(TimedRunner):
         self.color = ctx.texture((width, height), 4, dtype="f4")
         self.aux = ctx.texture((width, height), 4, dtype="f4")
         self.fbo = ctx.framebuffer(color_attachments=[self.color, self.aux])
-        uniforms = {
-            "u_resolution": (float(width), float(height)),
-            "u_eye": view.eye,
-            "u_target": view.target,
-            "u_up": view.up,
-            "u_fov_y": view.fov_y_deg,
-            "u_clip_center": view.clip_center,
-            "u_clip_radius": view.clip_radius,
-        }
-        for name, value in uniforms.items():
+        for name, value in camera_uniforms(view, width, height).items():
             if name in self.program:
                 self.program[name].value = value
         self.params = {p.name: p.uniform for p in params}
