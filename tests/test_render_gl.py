@@ -56,7 +56,9 @@ def test_the_frame_is_timed_after_the_driver_compile(tmp_path):
     """llvmpipe compiles a fragment shader at its first draw (0.39 s for the Barth
     sextic's exact program with the shader cache off, against 1 ms a frame at 48²): that
     compile is `timing.compile`, the warm-up, and `timing.frame` is a frame after it.
-    Judged as a ratio in one run, not as a time: measured about 400."""
+    Judged as a ratio in one run, not as a time: measured about 400, and 6.6 once on a
+    machine running two suites (one 48² frame preempted: 40 ms). A compile timed inside
+    the frame makes the ratio at most 1, so 3 still tells them apart."""
     require_gl()
     out = tmp_path / "b.png"
     env = {**os.environ, "MESA_SHADER_CACHE_DISABLE": "true"}  # the compile really runs
@@ -66,7 +68,7 @@ def test_the_frame_is_timed_after_the_driver_compile(tmp_path):
     assert proc.returncode == 0, proc.stderr
     timing = json.loads(out.with_suffix(".json").read_text())["timing"]
     assert set(timing) == {"setup", "compile", "frame"}
-    assert timing["compile"] > 10 * timing["frame"], timing
+    assert timing["compile"] > 3 * timing["frame"], timing
     assert "compile" in proc.stderr and "frame" in proc.stderr
 
 
