@@ -36,13 +36,14 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from eval_forms import sweep_equations  # noqa: E402
+from float32_renderers import reference as cached_reference  # noqa: E402
 
 from implc.emit import compile_shader, render_template  # noqa: E402
+from implc.framing import frame  # noqa: E402
 from implc.loaders import load_surface  # noqa: E402
 from implc.methods import get_method  # noqa: E402
 from implc.metrics import compare  # noqa: E402
 from implc.render.gl import GlRunner  # noqa: E402
-from implc.render.run import render  # noqa: E402
 
 TYPES = {"float": ("float", "vec3"), "double": ("double", "dvec3")}
 
@@ -90,8 +91,14 @@ def swap_ray(outer: str, inner_text: str, inner: str, text: str, n: int) -> str:
     return with_extension(text[:a] + record + body + wrapper + text[b:])
 
 
+def chmutov(n: int):
+    """Chmutov's T_n framed as every command frames it (float32_renderers' view, whose
+    certified references are cached)."""
+    return frame(load_surface(equation=sweep_equations(n)["chmutov"]))[0]
+
+
 def variants(n: int) -> tuple[object, dict[str, str]]:
-    surface = load_surface(equation=sweep_equations(n)["chmutov"])
+    surface = chmutov(n)
     constants = get_method("exact").defaults
     f = compile_shader(surface, "glsl", "exact", constants, "330", precision="float").text
     d = compile_shader(surface, "glsl", "exact", constants, "330", precision="double").text
@@ -115,8 +122,8 @@ def backends(degrees: list[int], size: int, names: list[str]) -> None:
     print("| degree | backend | false / missed / wrong | bad pixels |")
     print("|---|---|---|---|")
     for n in degrees:
-        surface = load_surface(equation=sweep_equations(n)["chmutov"])
-        reference = render(surface, "reference", "", get_method("taylor").defaults, size, size)
+        surface = chmutov(n)
+        reference = cached_reference(surface, size)
         for backend in names:
             runner = open_runner(surface, backend, "exact", get_method("exact").defaults,
                                  size, size)
@@ -150,7 +157,7 @@ def timing(degrees: list[int], size: int, frames: int, before: str | None) -> No
     print("| degree | exact ms | taylor ms | exact / taylor | before ms | before / taylor |")
     print("|---|---|---|---|---|---|")
     for n in degrees:
-        surface = load_surface(equation=sweep_equations(n)["chmutov"])
+        surface = chmutov(n)
         taylor = get_method("taylor").constants(
             evaluation=choose_form(get_method("taylor"), surface.expr))
         runners = [open_runner(surface, "gl", "exact", get_method("exact").defaults,
@@ -186,8 +193,7 @@ def main() -> None:
     print("|---|---|---|---|")
     for n in args.degrees:
         surface, programs = variants(n)
-        reference = render(surface, "reference", "", get_method("taylor").defaults,
-                           args.size, args.size)
+        reference = cached_reference(surface, args.size)
         for name, text in programs.items():
             runner = GlRunner(text, vertex, surface.view, args.size, args.size)
             try:
