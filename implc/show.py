@@ -20,7 +20,16 @@ from .raypoly import (
     ray_quantity_ops,
 )
 from .scaling import scale_exponent, scale_note
-from .solver import BERNSTEIN_FROM, BERNSTEIN_MAX_NODES, ROBUST_NEWTON_BELOW, walk_cost
+from .solver import (
+    BERNSTEIN_FROM,
+    BERNSTEIN_MAX_NODES,
+    RECENTER_FROM,
+    ROBUST_NEWTON_BELOW,
+    exact_coefficients,
+    in_chebyshev,
+    re_expands,
+    walk_cost,
+)
 from .surface import Surface
 from .targets import where_precision
 from .textform import to_text, value_text
@@ -124,6 +133,8 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
                     "segments)"]
     coefficients = coefficient_program(surface.expr, "float")
     if method.solves:
+        chebyshev = in_chebyshev(surface.expr, "float")
+        coefficients = exact_coefficients(surface.expr, "float")
         # double's program differs where powers stand alone on Horner's route, and where
         # double takes Horner's route for its registers (raypoly.DOUBLE_HORNER_FROM)
         double = coefficient_program(surface.expr, "double").ops_after
@@ -134,7 +145,7 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
             "exact (root isolation of the ray polynomial; no marching):",
             f"  coefficients c0..c{degree}, once per ray: {coefficients.ops_before} -> "
             f"{coefficients.ops_after} ops ({len(coefficients.assignments)} temporaries), "
-            + ROUTES[route],
+            + (CHEBYSHEV_ROUTE if chebyshev else ROUTES[route]),
             *([f"  in double (--precision double): {double} ops (one Horner's rule a "
                "coefficient, in o^2 where its powers share a parity)"
                + ("" if double_route == route else
@@ -142,7 +153,7 @@ def _ray_poly_counts(surface: Surface, method: Method, degree: int | None) -> li
                   "in double")]
               if double != coefficients.ops_after else []),
             *_solver_lines(surface.expr, degree, coefficients.ops_after,
-                           surface.limits.max_derived),
+                           surface.limits.max_derived, chebyshev),
         ]
     quantities = [q for kind, qs in evaluations(method, "ray-poly") if kind == "ray"
                   for q in qs]
@@ -174,16 +185,25 @@ ROUTES = {"tree": "by truncated arithmetic over S's tree as written, jointly CSE
                     f"operations; counted as printed for float32)"}
 
 
+CHEBYSHEV_ROUTE = ("from S in Chebyshev's basis of the box that holds its surface (in float32, "
+                   "where that basis holds S better than its monomials: implc/chebyshev.py)")
+
+
 def _short(expr: sympy.Expr, limit: int = 200) -> str:
     text = to_text(expr)[: -len(" = 0")]
     return text if len(text) <= limit else text[:limit] + " ..."
 
 
 def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int,
-                  max_derived: int) -> list[str]:
-    """The exact solver's strategy at this degree, its work per node or level, and (for
-    the Bernstein walk) the operations a ray costs."""
-    s_ops = build_programs(expr, (("S",),), max_derived)["S"].ops_after
+                  max_derived: int, chebyshev: bool) -> list[str]:
+    """The exact solver's float32 strategy at this degree, its work per node or level,
+    and (for the Bernstein walk) the operations a ray costs."""
+    if chebyshev:  # S at the point by Clenshaw's recurrences
+        from .chebyshev import chebyshev_program
+
+        s_ops = chebyshev_program(expr).ops_after
+    else:
+        s_ops = build_programs(expr, (("S",),), max_derived)["S"].ops_after
     if degree < BERNSTEIN_FROM:
         # F (P_n): Estrin's value and S at the point, both computed; a Newton or Halley
         # iteration reads F, F' and F''
@@ -199,7 +219,7 @@ def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int,
                 f"and F'' at a Newton or Halley iteration): {coefficient_ops + 5 * step:,} at "
                 f"5 iterations, {coefficient_ops + cap * step:,} at {cap}, the bound"
                 + (f" of each of up to {degree - 1} rounds" if degree == 4 else "")]
-    cost = walk_cost(degree, s_ops)
+    cost = walk_cost(degree, s_ops, chebyshev)
     node = cost.node + cost.node_end
 
     def per_ray(nodes: int, steps: int) -> str:
@@ -211,10 +231,16 @@ def _solver_lines(expr: sympy.Expr, degree: int, coefficient_ops: int,
         f"shift ({degree * (degree + 1) // 2} multiply-adds), {degree} scalings, the "
         f"Bernstein sums and the sign changes ({cost.node} operations) and F at the node's "
         f"end (S at the point, {cost.node_end}); then Newton, F "
-        f"{'at the point' if degree < ROBUST_NEWTON_BELOW else 'by Estrin'} and F' by "
+        f"{'at the point' if degree < ROBUST_NEWTON_BELOW or chebyshev else 'by Estrin'} "
+        "and F' by "
         f"Estrin's scheme, {cost.newton_step} a step",
         f"  per ray, about {coefficient_ops} + {cost.node_end} + nodes x {node} + Newton "
         f"steps x {cost.newton_step} operations: {per_ray(2, 5)}, {per_ray(6, 5)} "
         f"(measured: 2-6 nodes a ray on average, at most {BERNSTEIN_MAX_NODES}; 4.5 Newton "
         "steps a hit pixel at degree 18)",
+        *([f"  a node in doubt re-expands F about its own middle (degree >= {RECENTER_FROM} "
+           f"in Chebyshev's basis): {coefficient_ops} operations more each time, paid by the "
+           f"SIMD group of any lane that does (measured on Chmutov's T16, T18, T20 at 256^2: "
+           f"16 %, 22 %, 28 % of the pixels, 51 %, 60 %, 67 % of 8x8 groups)"]
+          if re_expands(expr, "float") else []),
     ]

@@ -289,6 +289,18 @@ def _chebyshev(expr: sympy.Expr, precision: str, ray: bool) -> Program | None:
     return chebyshev_ray_program(expr) if ray else chebyshev_program(expr)
 
 
+def in_chebyshev(expr: sympy.Expr, precision: str) -> bool:
+    """Whether exact's program takes S and the ray's coefficients from S in Chebyshev's
+    basis of its box (see _chebyshev)."""
+    return _chebyshev(expr, precision, ray=False) is not None
+
+
+def re_expands(expr: sympy.Expr, precision: str) -> bool:
+    """Whether exact's program re-expands F about a node in doubt (RECENTER_TOL): from
+    RECENTER_FROM, where its coefficients come from S in Chebyshev's basis."""
+    return (polynomial_degree(expr) or 0) >= RECENTER_FROM and in_chebyshev(expr, precision)
+
+
 def exact_coefficients(expr: sympy.Expr, precision: str) -> Program:
     """The program of the ray's coefficients exact's shader computes in `precision`."""
     chebyshev = _chebyshev(expr, precision, ray=True)
@@ -363,7 +375,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         # Newton and two polishing steps, 22, 115, 740 with Newton on S, at about the
         # same frame: 0.74 -> 0.65, 0.83 -> 0.79, 0.67 -> 0.71 of taylor's)
         robust_newton = n < ROBUST_NEWTON_BELOW or chebyshev is not None
-        recenter = chebyshev is not None and n >= RECENTER_FROM
+        recenter = re_expands(expr, printer.precision)
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
                         control_w, printer.float_literal(2 / n), robust_newton,
                         tuple((level, printer.float_literal(0.5 ** level), pairs)
@@ -459,13 +471,14 @@ class WalkCost:
     newton_step: int  # F (Estrin's, or S at the point below ROBUST_NEWTON_BELOW) and F'
 
 
-def walk_cost(n: int, s_ops: int) -> WalkCost:
-    """WalkCost of a degree-n walk whose S costs `s_ops` at a point."""
+def walk_cost(n: int, s_ops: int, chebyshev: bool = False) -> WalkCost:
+    """WalkCost of a degree-n walk whose S costs `s_ops` at a point (`chebyshev`: S and
+    the coefficients in Chebyshev's basis, where Newton reads S at the point)."""
     shift = n * (n + 1)  # n(n + 1)/2 multiply-adds
     scaling = 2 * n  # c_k nr^k (n products, n - 1 powers of nr) and nm/nr
     sums = sum(count_ops(even) + (count_ops(odd) + 2 if odd is not None else 0)
                for _, even, odd in bernstein_sums(n))
     signs = 2 * n  # a product and a comparison for each neighbouring pair
     at_point = s_ops + 6  # S at o + u d
-    f = at_point if n < ROBUST_NEWTON_BELOW else estrin_derivative_ops(n, 0)
+    f = at_point if n < ROBUST_NEWTON_BELOW or chebyshev else estrin_derivative_ops(n, 0)
     return WalkCost(shift + scaling + sums + signs, at_point, f + estrin_derivative_ops(n, 1))

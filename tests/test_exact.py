@@ -231,6 +231,27 @@ def test_show_names_the_solver_strategy():
     assert "by Horner's scheme nested over x, y, z" in long
 
 
+@pytest.mark.parametrize("n", [8, 14])
+def test_show_counts_the_program_exact_runs_in_float32(n):
+    """exact's float32 program on Chmutov's T_n takes S and its coefficients from
+    Chebyshev's basis (from degree ROBUST_NEWTON_BELOW) and re-expands F from
+    RECENTER_FROM: `implc show` counts that program, not the monomials'."""
+    import sympy
+
+    from implc.methods import get_method
+    from implc.show import describe
+    from implc.solver import RECENTER_FROM, exact_coefficients
+
+    equation = " + ".join(str(sympy.chebyshevt(n, sympy.Symbol(v))).replace("**", "^")
+                          for v in "xyz")
+    surface = load_surface(equation=equation)
+    text = describe(surface, get_method("exact"))
+    ops = exact_coefficients(surface.expr, "float").ops_after
+    assert f"once per ray: {ops} -> {ops} ops" in text
+    assert "from S in Chebyshev's basis" in text
+    assert ("re-expands F about its own middle" in text) == (n >= RECENTER_FROM)
+
+
 @pytest.mark.parametrize("backend", ["gl", "cl", "gl-double"])
 def test_bernstein_solver_holds_at_degree_14(backend):
     """The degree-14 trefoil knot of corpus row 247 at 128²: no false hit, missed and
