@@ -16,6 +16,8 @@ import sympy
 from .conditioning import (
     RAY_TO_PIXELS,
     RAY_WARN_SHARE,
+    RECENTER_TO_PIXELS,
+    RECENTER_WARN_SHARE,
     WARN_SHARE,
     Conditioning,
     float32_conditioning,
@@ -25,7 +27,7 @@ from .derive import polynomial_degree
 from .options import EXACT_MAX_DEGREE, T_TOL
 from .scaling import scale_exponent, scaled
 from .scene import View
-from .solver import ROBUST_NEWTON_BELOW, exact_coefficients
+from .solver import ROBUST_NEWTON_BELOW, exact_coefficients, re_expands
 from .surface import Surface
 from .symbols import POINT
 
@@ -36,6 +38,12 @@ class Float32Report:
 
     point: Conditioning | None  # S at sampled points of the surface: every method
     ray: Conditioning | None  # exact's ray coefficients on the view's pixel rays
+    re_expands: bool = False  # exact's walk re-expands F about a node in doubt
+
+    @property
+    def ray_to_pixels(self) -> str:
+        """exact's share of wrong pixels over the ray measure's share, where measured."""
+        return RECENTER_TO_PIXELS if self.re_expands else RAY_TO_PIXELS
 
     @property
     def point_warns(self) -> bool:
@@ -43,7 +51,8 @@ class Float32Report:
 
     @property
     def ray_warns(self) -> bool:
-        return self.ray is not None and self.ray.far >= RAY_WARN_SHARE
+        share = RECENTER_WARN_SHARE if self.re_expands else RAY_WARN_SHARE
+        return self.ray is not None and self.ray.far >= share
 
     def warning(self, method: str) -> str | None:
         """What float32 does to `method`'s picture where a measure says it is too far
@@ -54,7 +63,7 @@ class Float32Report:
             return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
                     f"moves the first root by more than {T_TOL:g} on "
                     f"{100 * self.ray.far:.2f} % of the view's pixel rays (exact's walk "
-                    f"reads them: expect wrong pixels, {RAY_TO_PIXELS} of that share where "
+                    f"reads them: expect wrong pixels, {self.ray_to_pixels} of that share where "
                     "measured)")
         if self.point_warns:
             return (f"float32 cannot hold this surface: a rounding of S moves it by more "
@@ -77,11 +86,12 @@ def float32_report(expr: sympy.Expr, view: View, degree: int,
         gradient = tuple(scaled(g, scale) for g in gradient)
     rays = (ray_conditioning(exact_coefficients(expr, "float"), view)
             if ray and ROBUST_NEWTON_BELOW <= degree <= EXACT_MAX_DEGREE else None)
+    recenters = rays is not None and re_expands(expr, "float")
     if not point:
-        return Float32Report(None, rays)
+        return Float32Report(None, rays, recenters)
     if gradient is None:
         gradient = tuple(sympy.diff(expr, v) for v in POINT)
-    return Float32Report(float32_conditioning(expr, gradient), rays)
+    return Float32Report(float32_conditioning(expr, gradient), rays, recenters)
 
 
 def float32_warning(surface: Surface, method: str) -> str | None:
