@@ -141,7 +141,8 @@ POLISH_STEPS = 2
 # ray's coefficients (whose rounding there is a share of terms about a far centre): on a wrong
 # slope it crept towards the root and stopped at NEWTON_STEPS short of it. At 512^2 on gl
 # (framed, the results page's view) T17-T20 19, 39, 64, 48 -> 1, 1, 5, 8 bad pixels (wgpu 0, 0,
-# 2, 9), T7-T16 unchanged; exact / taylor within 0.01 of before at T14-T19.
+# 2, 9), T7-T16 unchanged; exact / taylor within -0.04..+0.07 of before at T14-T20, medians of
+# the differences 0.00-0.02 (2-4 runs, loaded machine; docs/journal/2026-12-05-float32.md).
 RECENTER_TOL = 1e-4
 # The first expansion's centre, a share of the chord. At 512^2 on gl (bad pixels at
 # T14-T20, against the certified reference): 0.5 (the middle) 0, 1, 0, 19, 39, 62, 41;
