@@ -136,8 +136,14 @@ POLISH_STEPS = 2
 # T18 2, T20 3 at 1.05-1.2x it. Each re-expansion is a ray_of (1,151-1,333 operations at T16-T18)
 # paid by the SIMD group of any lane that needs it: exact / taylor at 512^2 T16 0.70 -> 0.89, T17
 # 0.71 -> 0.89, T18 0.77 -> 0.91, T19 0.75 -> 0.85, T20 0.67 -> 0.66 (over issue 48's 0.67). Re-
-# expanding a root node in doubt as well (about the chord's middle): T20 15, 1.3x a frame. Its
-# ray_of is the walk's only one, at the top of each round (templates/solver.j2): RDNA2 80-96
+# expanding a root node in doubt as well (about the chord's middle): T20 15, 1.3x a frame.
+# These programs' Newton after the walk takes F' from the gradient at the point, not from the
+# ray's coefficients (whose rounding there is a share of terms about a far centre): on a wrong
+# slope it crept towards the root and stopped at NEWTON_STEPS short of it. At 512^2 on gl
+# (framed, the results page's view) T17-T20 19, 39, 64, 48 -> 1, 1, 5, 8 bad pixels (wgpu 0, 0,
+# 2, 9), T7-T16 unchanged; exact / taylor within -0.04..+0.07 of before at T14-T20, medians of
+# the differences 0.00-0.02 (2-4 runs, loaded machine; docs/journal/2026-12-05-float32.md).
+# Its ray_of is the walk's only one, at the top of each round (templates/solver.j2): RDNA2 80-96
 # VGPRs at T14-T20 where a second call site in the loop held 112-128 (docs/results-float32.md).
 RECENTER_TOL = 1e-4
 # The first expansion's centre, a share of the chord. At 512^2 on gl (bad pixels at

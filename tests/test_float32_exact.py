@@ -7,7 +7,8 @@ monomials, 192^2, at most 0.01 % of the pixels bad (false + missed + wrong root)
 this change the float32 program had 24 bad pixels there on gl and on wgpu (0.065 %); now
 1-2. Chmutov's T_16 at the same size: 18 on gl with F expanded once about the chord's
 middle, 1 where a node in doubt is decided on F re-expanded about its own middle
-(solver.RECENTER_TOL)."""
+(solver.RECENTER_TOL). Chmutov's T_18 framed: 8 wrong roots on gl with Newton's slope from the
+ray's coefficients, 0 from the gradient at the point."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ from conftest import require_backend
 
 from implc.chebyshev import chebyshev_program, chebyshev_ray_program, surface_box
 from implc.emit import emit
+from implc.framing import frame
 from implc.loaders import load_surface
 from implc.methods import METHODS
 from implc.metrics import compare
@@ -31,12 +33,19 @@ SIZE = 192
 BAD_SHARE = 1e-4  # the issue's bound: 0.01 % of the pixels
 
 
-@pytest.fixture(scope="module", params=[12, 16], ids=lambda n: f"T{n}")
+@pytest.fixture(scope="module", params=[(12, False), (16, False), (18, True)],
+                ids=lambda p: f"T{p[0]}" + ("-framed" if p[1] else ""))
 def chmutov_reference(request):
     """T_12: S's monomials do not fit float32, its Chebyshev form does. T_16: besides, the
     chord's power series rounds to more than F near roots at the box's edge (a root pair
-    skipped, a later root taken); re-expanded about a node in doubt it holds."""
-    surface = load_surface(equation=chmutov(request.param))
+    skipped, a later root taken); re-expanded about a node in doubt it holds. T_18 framed
+    as every command frames it: besides, Newton's slope from the ray's coefficients rounds
+    so far off that its NEWTON_STEPS end short of the root (8 wrong roots on gl); from the
+    gradient it converges."""
+    degree, framed = request.param
+    surface = load_surface(equation=chmutov(degree))
+    if framed:
+        surface = frame(surface)[0]
     return surface, render(surface, "reference", "", METHODS["taylor"].defaults, SIZE, SIZE)
 
 
