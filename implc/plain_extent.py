@@ -130,24 +130,23 @@ def sign_changes(expr: sympy.Expr, center: Sequence[float],
     spacing = 2.0 * half / GRID
     axes = [[c - half + spacing * (SHIFT + i) for i in range(GRID + 1)] for c in center]
     values = grid_values(expr, axes)
+    sign = [1 if v > 0 else -1 if v < 0 else 0 for v in values]  # NaN: 0, no change
     size = GRID + 1
-    strides = (size * size, size, 1)
     found: list[Point] = []
     touching = False
-    for axis in range(3):
-        step = strides[axis]
-        for a in range(size - (axis == 0)):
-            for b in range(size - (axis == 1)):
-                base = a * strides[0] + b * strides[1]
-                for c in range(size - (axis == 2)):
-                    fa, fb = values[base + c], values[base + c + step]
-                    if not ((fa > 0 and fb < 0) or (fa < 0 and fb > 0)):
-                        continue
-                    index = (a, b, c)
-                    touching = touching or any(i == 0 or i >= GRID - 1 for i in index)
-                    coords = [axes[k][index[k]] for k in range(3)]
-                    coords[axis] = coords[axis] + spacing * (fa / (fa - fb))
-                    found.append((coords[0], coords[1], coords[2]))
+    for axis, step in enumerate((size * size, size, 1)):
+        # the edges from grid point i to i + step (flat, C order: numpy's nonzero order)
+        changes = [i for i, (sa, sb) in enumerate(zip(sign, sign[step:], strict=False))
+                   if sa * sb < 0]
+        for i in changes:
+            index = (i // (size * size), i // size % size, i % size)
+            if index[axis] == GRID:  # no edge: i is on the far face along this axis
+                continue
+            touching = touching or any(k == 0 or k >= GRID - 1 for k in index)
+            fa, fb = values[i], values[i + step]
+            coords = [axes[k][index[k]] for k in range(3)]
+            coords[axis] = coords[axis] + spacing * (fa / (fa - fb))
+            found.append((coords[0], coords[1], coords[2]))
     return found, spacing, touching
 
 
