@@ -219,33 +219,55 @@ def _powers(v: float, top: int) -> list[float]:
 
 def walk(expr: sympy.Expr, point: Point) -> float:
     """S at a point as numeric.evaluate's walker rounds it: sums and products left to
-    right, integer powers by halves (b^n = b^(n // 2) b^(n - n // 2))."""
-    env = dict(zip(POINT, point, strict=True))
-    cache: dict[sympy.Basic, float] = {}
+    right, integer powers by halves (b^n = b^(n // 2) b^(n - n // 2)); from S's tape, so
+    that the clip sphere's 8,192 points read S's tree once."""
+    values: list[float] = []
+    for op, arg in _tape(expr):
+        if op == "var":
+            value = point[arg]
+        elif op == "const":
+            value = arg
+        elif op == "pow":
+            value = _by_halves(values[arg[0]], arg[1])
+        elif op == "sqrt":
+            base = values[arg]
+            value = math.sqrt(base) if base >= 0 else math.nan
+        else:
+            value = values[arg[0]]
+            for k in arg[1:]:
+                value = value + values[k] if op == "add" else value * values[k]
+        values.append(value)
+    return values[-1]
 
-    def value(node: sympy.Basic) -> float:
-        if node in cache:
-            return cache[node]
-        if node.is_Symbol:
-            result = env[node]
+
+@lru_cache(maxsize=8)
+def _tape(expr: sympy.Expr) -> tuple[tuple[str, object], ...]:
+    """S's distinct sub-expressions in the order the walker evaluates them, each an
+    operation on earlier ones (their indices), S last."""
+    tape: list[tuple[str, object]] = []
+    index: dict[sympy.Basic, int] = {}
+
+    def visit(node: sympy.Basic) -> int:
+        if node in index:
+            return index[node]
+        if node.is_Symbol and node in POINT:
+            entry: tuple[str, object] = ("var", POINT.index(node))
         elif node.is_Number or node.is_NumberSymbol:
-            result = float(node)
+            entry = ("const", float(node))
         elif node.is_Add or node.is_Mul:
-            parts = [value(a) for a in node.args]
-            result = parts[0]
-            for p in parts[1:]:
-                result = result + p if node.is_Add else result * p
+            entry = ("add" if node.is_Add else "mul", tuple(visit(a) for a in node.args))
         elif node.is_Pow and node.exp.is_Integer and node.exp >= 0:
-            result = _by_halves(value(node.base), int(node.exp))
+            entry = ("pow", (visit(node.base), int(node.exp)))
         elif node.is_Pow and node.exp == sympy.Rational(1, 2):
-            base = value(node.base)
-            result = math.sqrt(base) if base >= 0 else math.nan
+            entry = ("sqrt", visit(node.base))
         else:
             raise NotImplementedError(f"no plain meaning for {type(node).__name__}")
-        cache[node] = result
-        return result
+        index[node] = len(tape)
+        tape.append(entry)
+        return index[node]
 
-    return value(expr)
+    visit(expr)
+    return tuple(tape)
 
 
 def _by_halves(base: float, n: int) -> float:
