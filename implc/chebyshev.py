@@ -15,11 +15,13 @@ the median distance moved 4e-4 in monomials at T_20, 2e-8 here.
 
 The box is the surface's sampled sign changes (implc/extent.py), a grid cell wider each
 side and rounded outwards to a power of two's multiple, so the change of variables is
-exact. Outside the box the basis grows as the polynomial does: its rounding stays a
-share of S's own size there.
+exact: chosen by implc/box_choice.py, with numpy's arrays where numpy loads, in plain
+Python where it does not (the same box: the program's bytes do not depend on numpy).
+Outside the box the basis grows as the polynomial does: its rounding stays a share of S's
+own size there.
 
-Only where it pays: the monomials' magnitude at the box's far corner must exceed the
-Chebyshev coefficients' sum GAIN times (the sums of powers x^n + y^n + z^n - 1, already
+Only where it pays: the monomials must move the sampled surface GAIN times farther than
+Chebyshev's basis (box_choice.py) (the sums of powers x^n + y^n + z^n - 1, already
 well conditioned, keep their monomials)."""
 
 from __future__ import annotations

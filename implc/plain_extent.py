@@ -9,7 +9,7 @@ that can decide a sign: the walker's values (S's tree, left to right) wherever t
 expanded form's rounding bound reaches |S|. The contraction's own sums round in another
 order than numpy's einsum (its last bits differ): a sign change moves by an ulp, and the
 box, rounded outwards to a dyadic grid, does not (tests/test_box_choice.py checks bundled
-surfaces). Pure Python costs about a second a 65^3 grid where numpy takes 0.05 s:
+surfaces). Pure Python takes about half a second a 65^3 grid where numpy takes 0.05 s:
 only the compile without numpy pays it, for a float32 exact program from degree 7."""
 
 from __future__ import annotations
