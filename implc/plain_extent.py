@@ -260,6 +260,8 @@ def _tape(expr: sympy.Expr) -> tuple[tuple[str, object], ...]:
             entry = ("pow", (visit(node.base), int(node.exp)))
         elif node.is_Pow and node.exp == sympy.Rational(1, 2):
             entry = ("sqrt", visit(node.base))
+        elif not node.free_symbols:  # a constant such as cos(1): its correctly rounded value
+            entry = ("const", float(node))
         else:
             raise NotImplementedError(f"no plain meaning for {type(node).__name__}")
         index[node] = len(tape)
