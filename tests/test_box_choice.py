@@ -53,3 +53,18 @@ def test_the_plain_box_is_numpys(n):
     box = box_numpy.surface_box(expr)
     assert (box is not None) == (n == 8)
     assert _plain_box(expr) == box
+
+
+# the search's rarer branches: a surface smaller than a cell of the first cube (shrinking
+# cubes), one thinner than a cell (grown until clear of the clip sphere), one whose arms
+# still pierce the grown sphere (unbounded), none at all
+BRANCHES = ("(x-0.37)^2 + (y+0.21)^2 + z^2 - 0.0003 = 0", "x^2/100 + y^2 + z^2/0.01 = 1",
+            "6x^2 - 2x^4 = y^2 z^2", "x^2 + y^2 + z^2 + 1 = 0")
+
+
+@pytest.mark.parametrize("equation", BRANCHES)
+def test_the_plain_search_takes_numpys_branches(equation):
+    expr = load_surface(equation=equation).expr
+    extent = locate_surface(expr)
+    assert plain_extent.locate(expr) == (None if extent is None
+                                         else (extent.center, extent.radius))
