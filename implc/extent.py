@@ -26,18 +26,22 @@ import numpy as np
 import sympy
 
 from .numeric import evaluate, evaluate_on_grid
+from .plain_extent import (
+    GRID,
+    GROWING,
+    GROWTH,
+    GROWTH_STEPS,
+    MARGIN,
+    SHIFT,
+    SHRINKING,
+    SPHERE_SAMPLES,
+)
 from .scene import Extent, Vec3
 from .symbols import POINT
 
-GRID = 64  # cells a side; (GRID + 1)^3 = 274,625 samples a cube
-SHIFT = 0.2718  # of a cell: where the grid starts inside the cube
-GROWING = (2.0, 8.0, 32.0, 128.0, 512.0, 2048.0)
-SHRINKING = (0.5, 0.125, 0.03125)
+# the grid and the search's steps (their values and meaning in plain_extent.py, the search
+# written in plain Python, which must sample what this one samples)
 SEARCHED = GROWING[-1]
-MARGIN = 1.05  # the clip sphere is 5 % larger than the farthest sign change, plus a cell
-SPHERE_SAMPLES = 8192  # points on the clip sphere for `crosses_sphere`
-GROWTH = 1.25  # the clip sphere's step while the surface pierces it (`_clear_of_sphere`)
-GROWTH_STEPS = 3  # ... at most (1.95 times): pierced beyond that, the surface is unbounded
 
 
 def locate_surface(expr: sympy.Expr, center: Vec3 | None = None) -> Extent | None:

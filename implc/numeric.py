@@ -7,12 +7,13 @@ of every node is the one written in `functions.FUNCTIONS` (the same as the shade
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from functools import lru_cache
 
 import numpy as np
 import sympy
 
 from .functions import BY_SYMPY_NAME
+from .plain_extent import float_terms as _expanded
+from .plain_extent import sum_of_monomials as _monomials
 from .symbols import POINT
 
 
@@ -193,7 +194,6 @@ def evaluate_on_grid(expr: sympy.Expr, axes: Sequence[np.ndarray]) -> np.ndarray
     return np.broadcast_to(evaluate(expr, env), shape)
 
 
-EXPAND_UP_TO = 24  # degree: at most 2,925 monomials, expanded in 0.1 s
 
 
 def _contract(monomials: Mapping[tuple[int, int, int], float],
@@ -206,22 +206,6 @@ def _contract(monomials: Mapping[tuple[int, int, int], float],
               for a, d in zip(axes, degrees, strict=True)]
     with np.errstate(all="ignore"):
         return np.einsum("ijk,ia,jb,kc->abc", tensor, *powers, optimize=True)
-
-
-@lru_cache(maxsize=8)
-def _expanded(expr: sympy.Expr) -> dict[tuple[int, int, int], float] | None:
-    """S's monomials with float coefficients, for a polynomial of degree at most
-    EXPAND_UP_TO whose coefficients are numbers, else None. Cached (framing's cubes ask
-    again); read, never changed."""
-    from .derive import expanded_terms, polynomial_degree
-
-    degree = polynomial_degree(expr)
-    if degree is None or degree > EXPAND_UP_TO:
-        return None
-    terms = expanded_terms(expr)
-    if not terms or any(not c.is_number for c in terms.values()):
-        return None
-    return {key: float(c) for key, c in terms.items()}
 
 
 def _checked_contraction(expr: sympy.Expr, monomials: dict[tuple[int, int, int], float],
@@ -241,21 +225,3 @@ def _checked_contraction(expr: sympy.Expr, monomials: dict[tuple[int, int, int],
         env = {v: np.asarray(axes[k], dtype=np.float64)[index[k]] for k, v in enumerate(POINT)}
         values[index] = np.broadcast_to(evaluate(expr, env), index[0].shape)
     return values
-
-
-def _monomials(expr: sympy.Expr) -> dict[tuple[int, int, int], float] | None:
-    """{(i, j, k): c} of a sum of monomials c x^i y^j z^k with numeric c, else None."""
-    result: dict[tuple[int, int, int], float] = {}
-    for term in sympy.Add.make_args(expr):
-        coefficient, rest = term.as_coeff_Mul()
-        if not coefficient.is_Number:
-            return None
-        exponents = [0, 0, 0]
-        for factor in sympy.Mul.make_args(rest) if rest != 1 else ():
-            base, exp = factor.as_base_exp()
-            if base not in POINT or not exp.is_Integer or exp < 1:
-                return None
-            exponents[POINT.index(base)] += int(exp)
-        key = (exponents[0], exponents[1], exponents[2])
-        result[key] = result.get(key, 0.0) + float(coefficient)
-    return result

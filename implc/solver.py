@@ -111,7 +111,7 @@ FIRST_HALVINGS = 3
 
 # Where the Newton after the walk reads Estrin's value of the chord's coefficients (from
 # ROBUST_NEWTON_BELOW) in float32 and S stays in monomials (no gain from Chebyshev's basis,
-# --params uniform, or no numpy), this many Newton steps on F's robust value (S at the
+# or --params uniform), this many Newton steps on F's robust value (S at the
 # point) follow it, inside the root node. The chord's coefficients are a Taylor expansion
 # about the chord's middle, computed from S's monomials: in float32 their rounding can be a
 # share of terms far larger than F near its root (Chmutov's T_12 written in monomials, a
@@ -283,15 +283,13 @@ def _chebyshev(expr: sympy.Expr, precision: str, ray: bool) -> Program | None:
     """S (or, with `ray`, the ray's coefficients) from S in Chebyshev's basis of its box
     (implc/chebyshev.py), where exact's program takes them: in float32, from
     ROBUST_NEWTON_BELOW (where its Newton and walk read them), where that basis holds S
-    better than its monomials; else None. The box is found by sampling S with numpy:
-    where numpy cannot load (the compile path needs only sympy and jinja2, issue 43), S's
-    monomials are kept, and such a program differs from the one compiled with numpy."""
+    better than its monomials; else None. The box is found by sampling S, with numpy or,
+    where numpy cannot load (issue 43), in plain Python: the same box, the same program
+    (issue 48)."""
     if precision != "float" or (polynomial_degree(expr) or 0) < ROBUST_NEWTON_BELOW:
         return None
-    try:
-        from .chebyshev import chebyshev_program, chebyshev_ray_program
-    except ImportError:  # numpy missing
-        return None
+    from .chebyshev import chebyshev_program, chebyshev_ray_program
+
     if chebyshev_program(expr) is None:
         return None
     return chebyshev_ray_program(expr) if ray else chebyshev_program(expr)

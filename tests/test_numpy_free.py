@@ -6,7 +6,9 @@ report and measuring, which import it when they are asked for.
 This file is also the child process of the test: run as a script, it blocks numpy with a
 meta-path finder before importing implc, compiles `cases()` and prints each shader's sha256;
 the test compiles the same in its own process, numpy loaded, and compares, so the
-numpy-free path must give the same bytes, not merely run."""
+numpy-free path must give the same bytes, not merely run. That includes a float32 exact
+program of degree 12 (`CHEBYSHEV`), whose S is written in Chebyshev's basis of a box
+chosen by sampling S: in plain Python without numpy (issue 48)."""
 
 from __future__ import annotations
 
@@ -30,6 +32,8 @@ SURFACES: dict[str, tuple[str | None, str | None, tuple[str, ...]]] = {
     "sin": (None, "sin(3x) + cos(2y) + z^2 - 1 = 0", ()),  # not a polynomial
 }
 HAS_PARAMS = ("torus", "param")
+# a float32 exact program whose S is in Chebyshev's basis of a sampled box: every target
+CHEBYSHEV = 12  # Chmutov's T_n
 METHODS = ("taylor", "interval", "exact")  # beside hessian
 PARAM_MODES = ["constant", "uniform"]
 
@@ -67,6 +71,7 @@ def digests() -> dict[str, str]:
     """sha256 of each case's shader text (or of the error refusing it)."""
     from implc.emit import emit
     from implc.errors import ImplcError
+    from implc.targets import TARGETS
 
     load_surface = _load_surface()
     surfaces = {name: load_surface(spec, equation, params) if spec is None
@@ -82,6 +87,15 @@ def digests() -> dict[str, str]:
         except ImplcError as err:  # a refused combination: its message
             text = f"{type(err).__name__}: {err}"
         result["|".join(case)] = hashlib.sha256(text.encode()).hexdigest()
+    from cases import chmutov
+
+    chebyshev = load_surface(equation=chmutov(CHEBYSHEV))
+    for target in TARGETS.values():
+        if "float" in target.precisions:
+            text = emit(chebyshev, target.name, "exact", flavor=target.default_flavor,
+                        precision="float")
+            result[f"chmutov{CHEBYSHEV}|{target.name}|exact|float"] = \
+                hashlib.sha256(text.encode()).hexdigest()
     import implc  # the public API's compile, on examples whose files set their view
 
     for name, target in itertools.product(("cross-cap", "torus"), ("glsl", "wgsl", "hlsl")):
@@ -132,11 +146,17 @@ def test_compiling_imports_no_numpy_and_gives_the_same_bytes():
     assert report["digests"].keys() == expected.keys()
     different = [k for k, v in expected.items() if report["digests"][k] != v]
     assert not different, f"shaders differ without numpy: {different[:10]}"
-    # where the text may differ (a float32 exact program from degree 7: Chebyshev's basis
-    # is chosen by sampling S with numpy), the compile says so
-    said = " ".join(report["notes"])
-    assert "float32 not measured" in said and "may differ" in said, report["notes"]
+    said = " ".join(report["notes"])  # what the compile could not do, it says
+    assert "float32 not measured" in said and "may differ" not in said, report["notes"]
     assert len(expected) > 100
+    chebyshev = [k for k in expected if k.startswith(f"chmutov{CHEBYSHEV}|")]
+    assert len(chebyshev) >= 3, chebyshev  # and they are written in Chebyshev's basis:
+    from cases import chmutov
+
+    from implc.chebyshev import chebyshev_program
+    from implc.loaders import load_surface
+
+    assert chebyshev_program(load_surface(equation=chmutov(CHEBYSHEV)).expr) is not None
 
 
 if __name__ == "__main__":

@@ -70,10 +70,7 @@ def float32_finding(record: SurfaceRecord, method: str) -> tuple[str | None, str
     try:
         from ..float32 import float32_warning
     except ImportError as err:  # compiling needs sympy and jinja2 only; the measure numpy
-        return None, (f"float32 not measured ({err.name or 'numpy'} is not installed); "
-                      "a float32 exact program of degree 7 or more keeps S's monomials, "
-                      "where numpy's compile may choose Chebyshev's basis (by sampling S), "
-                      "so its text may differ")
+        return None, f"float32 not measured ({err.name or 'numpy'} is not installed)"
     return float32_warning(record, method), None
 
 
