@@ -143,6 +143,12 @@ POLISH_STEPS = 2
 # (framed, the results page's view) T17-T20 19, 39, 64, 48 -> 1, 1, 5, 8 bad pixels (wgpu 0, 0,
 # 2, 9), T7-T16 unchanged; exact / taylor within -0.04..+0.07 of before at T14-T20, medians of
 # the differences 0.00-0.02 (2-4 runs, loaded machine; docs/journal/2026-12-05-float32.md).
+# A root node in doubt (one sign change of its coefficients, the same test as a skip's) is
+# re-expanded too: its one change may be three roots the rounding merged, and Newton took
+# the last. Chmutov at 192^2 on gl, the default view (not framed): T19 19 -> 1, T20 57 -> 9
+# bad pixels (3 of them false hits the double program has too); framed at 512^2 T18 1 -> 0,
+# the rest unchanged; exact / taylor at 512^2 T14-T20 0.49, 0.55, 0.60, 0.66, 0.70, 0.77, 0.64
+# -> 0.54, 0.60, 0.65, 0.74, 0.76, 0.80, 0.68 (one run, in turns, 7 frames).
 # Its ray_of is the walk's only one, at the top of each round (templates/solver.j2): RDNA2 80-96
 # VGPRs at T14-T20 where a second call site in the loop held 112-128 (docs/results-float32.md).
 RECENTER_TOL = 1e-4

@@ -8,7 +8,8 @@ this change the float32 program had 24 bad pixels there on gl and on wgpu (0.065
 1-2. Chmutov's T_16 at the same size: 18 on gl with F expanded once about the chord's
 middle, 1 where a node in doubt is decided on F re-expanded about its own middle
 (solver.RECENTER_TOL). Chmutov's T_18 framed: 8 wrong roots on gl with Newton's slope from the
-ray's coefficients, 0 from the gradient at the point."""
+ray's coefficients, 0 from the gradient at the point. Chmutov's T_19: 19 wrong roots on gl where a
+root node in doubt was taken as it came, 1 where it is re-expanded too."""
 
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ SIZE = 192
 BAD_SHARE = 1e-4  # the issue's bound: 0.01 % of the pixels
 
 
-@pytest.fixture(scope="module", params=[(12, False), (16, False), (18, True)],
+@pytest.fixture(scope="module", params=[(12, False), (16, False), (18, True), (19, False)],
                 ids=lambda p: f"T{p[0]}" + ("-framed" if p[1] else ""))
 def chmutov_reference(request):
     """T_12: S's monomials do not fit float32, its Chebyshev form does. T_16: besides, the
@@ -41,7 +42,9 @@ def chmutov_reference(request):
     skipped, a later root taken); re-expanded about a node in doubt it holds. T_18 framed
     as every command frames it: besides, Newton's slope from the ray's coefficients rounds
     so far off that its NEWTON_STEPS end short of the root (8 wrong roots on gl); from the
-    gradient it converges."""
+    gradient it converges. T_19: besides, a root node whose rounded coefficients change
+    sign once may hold three roots (Newton took the last: 19 wrong roots on gl); decided
+    on F re-expanded about its own middle, 1."""
     degree, framed = request.param
     surface = load_surface(equation=chmutov(degree))
     if framed:
