@@ -149,6 +149,9 @@ POLISH_STEPS = 2
 # bad pixels (3 of them false hits the double program has too); framed at 512^2 T18 1 -> 0,
 # the rest unchanged; exact / taylor at 512^2 T14-T20 0.49, 0.55, 0.60, 0.66, 0.70, 0.77, 0.64
 # -> 0.54, 0.60, 0.65, 0.74, 0.76, 0.80, 0.68 (one run, in turns, 7 frames).
+# RECENTER_TOL 3e-2 or 1e-1 would take T20's last 6 wrong roots there (skipped root pairs: the
+# coefficients' rounding is a share of the terms that made them, larger than scale_at says),
+# at exact / taylor 0.65-0.97 against 0.54-0.80: not kept (1e-2 leaves them).
 # Its ray_of is the walk's only one, at the top of each round (templates/solver.j2): RDNA2 80-96
 # VGPRs at T14-T20 where a second call site in the loop held 112-128 (docs/results-float32.md).
 RECENTER_TOL = 1e-4
