@@ -16,7 +16,7 @@ import sympy
 from .conditioning import (
     RAY_TO_PIXELS,
     RAY_WARN_SHARE,
-    RECENTER_TO_PIXELS,
+    RECENTER_RIGHT_UP_TO,
     RECENTER_WARN_SHARE,
     WARN_SHARE,
     Conditioning,
@@ -41,9 +41,13 @@ class Float32Report:
     re_expands: bool = False  # exact's walk re-expands F about a node in doubt
 
     @property
-    def ray_to_pixels(self) -> str:
-        """exact's share of wrong pixels over the ray measure's share, where measured."""
-        return RECENTER_TO_PIXELS if self.re_expands else RAY_TO_PIXELS
+    def ray_pixels(self) -> str:
+        """What the ray measure's share says of exact's wrong pixels, where measured."""
+        if self.re_expands:
+            return (f"its walk re-expands F where they leave a node in doubt, and was right "
+                    f"up to {100 * RECENTER_RIGHT_UP_TO:.0f} % of the rays where measured; "
+                    "beyond that, expect wrong pixels")
+        return f"its walk reads them: expect wrong pixels, {RAY_TO_PIXELS} of that share"
 
     @property
     def point_warns(self) -> bool:
@@ -62,9 +66,8 @@ class Float32Report:
         if method == "exact" and self.ray_warns:
             return (f"float32 cannot hold this surface: rounding exact's ray coefficients "
                     f"moves the first root by more than {T_TOL:g} on "
-                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (exact's walk "
-                    f"reads them: expect wrong pixels, {self.ray_to_pixels} of that share where "
-                    "measured)")
+                    f"{100 * self.ray.far:.2f} % of the view's pixel rays (exact: "
+                    f"{self.ray_pixels})")
         if self.point_warns:
             return (f"float32 cannot hold this surface: a rounding of S moves it by more "
                     f"than {T_TOL:g} at {100 * self.point.far:.1f} % of its sampled points "

@@ -101,9 +101,7 @@ def _float32_lines(surface: Surface, degree: int,
                      f"the first root by {ray.median:.1e} (median), {ray.p90:.1e} (p90) on "
                      f"{ray.points:,} pixel rays; {100 * ray.far:.2f} % more than {T_TOL:g}")
         if report.ray_warns:
-            lines.append("           warning: expect wrong roots in float32 on "
-                         f"{report.ray_to_pixels} of that share of exact's pixels (where "
-                         "measured)")
+            lines.append(f"           warning: {report.ray_pixels}")
     scale = scale_exponent(surface.expr)
     if scale:
         lines.append(f"           measured as the shader computes S: {scale_note(scale)}")
