@@ -222,6 +222,9 @@ class Solver:
     # printed ("": F is expanded once, about the chord's middle)
     recenter_tol: str = ""
     recenter_at: str = ""
+    # bernstein: Newton's start computed after the walk from the root node's coefficients
+    # again, not kept through it (double: RDNA3 spilled the walk from degree 13)
+    late_start: bool = False
 
 
 @dataclass(frozen=True)
@@ -399,7 +402,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         else 0,
                         *((printer.float_literal(RECENTER_TOL),
                            printer.float_literal(RECENTER_AT)) if recenter
-                          else ()))
+                          else ()), late_start=printer.precision == "double")
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
