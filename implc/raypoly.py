@@ -193,18 +193,20 @@ def _horner(terms: dict, order: tuple[int, ...], n: int, combine, precision: str
         if plain:
             constants = {e: terms[_unpermuted(prefix + (e,) + (0,) * (2 - depth), order)]
                          for e in plain}
-            direct = _shifted(constants, o, d, combine, precision)
-            q = [combine([(v[m], None) for v in (q, direct) if m < len(v)])
-                 for m in range(max(len(q), len(direct)))]
+            q = _shifted(constants, o, d, combine, precision, q)
         return q
 
     return level(0, ())
 
 
 def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
-             combine, precision: str) -> list:
-    """The ray coefficients of sum a_e v^e over `constants` (e -> a_e, e >= 1) by a Taylor
-    shift: c_j = d^j p_j(o), p_j = sum_(e >= j) a_e C(e, j) v^(e - j). Horner's loop over
+             combine, precision: str, base: list) -> list:
+    """`base` (ray coefficients) plus those of sum a_e v^e over `constants` (e -> a_e,
+    e >= 1) by a Taylor shift: c_j = d^j p_j(o), p_j = sum_(e >= j) a_e C(e, j) v^(e - j).
+    In double each c_j is added to base_j as soon as it is made, so its p_j and d^j die
+    there: made all first, then added (fused into multiply-adds, so their products moved
+    to the additions too), every p_j, power of d and base_j were live at once (Chmutov
+    T20: 126 of RDNA's VGPRs before the walk, 152 in all). Horner's loop over
     (o + d s) pays a product and a multiply-add for every coefficient of every step; here
     each p_j(o) costs a multiply-add a term:
     - in float32, all p_j by repeated synthetic division (Horner's rule again), which
@@ -218,25 +220,39 @@ def _shifted(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
     parity Horner put T16's wrong roots at 16,719, and sums of a_e C(e, j) o^(e - j) at
     26,615: their terms cancel where the division's partial sums stay small."""
     top = max(constants)
-    if precision == "float":
-        p: list = [constants.get(e) for e in range(top + 1)]  # None: zero
-        for j in range(top):
-            for e in range(top - 1, j - 1, -1):
-                p[e] = combine(([] if p[e] is None else [(p[e], None)]) + [(p[e + 1], o)])
-    else:
-        a = {e: combine([(value, None)]) for e, value in sorted(constants.items())}
-        sums = [{e - j: comb(e, j) * value for e, value in a.items() if e >= j}
-                for j in range(top + 1)]
-        square = (combine([(o, o)]) if any(_parity(terms)[0] == 2 for terms in sums)
-                  else None)
-        p = [_horner_at(o, square, terms, combine) for terms in sums]
+    if precision != "float":
+        return _shifted_double(constants, o, d, combine, base)
+    p: list = [constants.get(e) for e in range(top + 1)]  # None: zero
+    for j in range(top):
+        for e in range(top - 1, j - 1, -1):
+            p[e] = combine(([] if p[e] is None else [(p[e], None)]) + [(p[e + 1], o)])
     direct = [p[0]]  # never None: the division's first pass sets every p[e] below top
     power = d
     for j in range(1, top + 1):
         if j > 1:
             power = combine([(power, d)])
         direct.append(combine([(p[j], power)]))
-    return direct
+    return [combine([(v[m], None) for v in (base, direct) if m < len(v)])
+            for m in range(max(len(base), len(direct)))]
+
+
+def _shifted_double(constants: dict[int, sympy.Expr], o: sympy.Symbol, d: sympy.Symbol,
+                    combine, base: list) -> list:
+    """_shifted in double: each p_j by its own Horner's rule, then d^j p_j added to base_j
+    at once (base_j + p_j d^j, one multiply-add)."""
+    top = max(constants)
+    a = {e: combine([(value, None)]) for e, value in sorted(constants.items())}
+    sums = [{e - j: comb(e, j) * value for e, value in a.items() if e >= j}
+            for j in range(top + 1)]
+    square = (combine([(o, o)]) if any(_parity(terms)[0] == 2 for terms in sums)
+              else None)
+    out, power = [], None
+    for j, terms in enumerate(sums):
+        p = _horner_at(o, square, terms, combine)
+        if j:
+            power = d if j == 1 else combine([(power, d)])
+        out.append(combine(([(base[j], None)] if j < len(base) else []) + [(p, power)]))
+    return out + base[top + 1:]
 
 
 def _parity(terms: dict[int, sympy.Expr]) -> tuple[int, int]:

@@ -234,6 +234,9 @@ class Solver:
     # printed ("": F is expanded once, about the chord's middle)
     recenter_err: str = ""
     recenter_at: str = ""
+    # bernstein: Newton's start computed after the walk from the root node's coefficients
+    # again, not kept through it (double: RDNA3 spilled the walk from degree 13)
+    late_start: bool = False
 
 
 @dataclass(frozen=True)
@@ -411,7 +414,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         else 0,
                         *((printer.float_literal(RECENTER_ERR),
                            printer.float_literal(RECENTER_AT)) if recenter
-                          else ()))
+                          else ()), late_start=printer.precision == "double")
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
@@ -447,8 +450,9 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
     rounding of b is bounded by n eps sum |e_k| (about the node's start, as before, the
     bound grew like 3^n sum |e_k|: 57 wrong or missed pixels of 16,384 at degree 14).
     beta_(n-i),k = (-1)^k beta_ik: the even part (k even) and the odd part are summed once
-    for i <= n/2 and give b_i and b_(n-i) by a sum and a difference. With each let, the
-    j of every pair (b_(j-1), b_j) whose sign change can be counted after it."""
+    for i <= n/2 and give b_i and b_(n-i) by a sum and a difference; in double from the
+    middle out (b_n, b_(n-1), read after the sums, are made last: 4 VGPRs fewer held
+    through them). With each let, the pairs (b_(j-1), b_j) by j it completes."""
     lets: list[tuple[str, str, tuple[int, ...]]] = []
     known: set[int] = set()
 
@@ -458,7 +462,7 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
         lets.append((f"b{i}", value, tuple(j for j in (i, i + 1)
                                             if j - 1 in known and j in known)))
 
-    for i, even, odd in bernstein_sums(n):
+    for i, even, odd in bernstein_sums(n)[::-1 if printer.precision == "double" else 1]:
         if odd is None:  # the middle coefficient
             coefficient(i, printer.doprint(even))
             continue

@@ -12,8 +12,9 @@ each method's DOUBLE_UP_TO. `make test` samples degrees
 The occupancy guard: exact holds at most EXACT_VGPRS_BELOW VGPRs on RDNA2 below degree
 13 and EXACT_VGPRS from there (Chmutov's and the bundled surfaces).
 
-Double (GLSL 450) still spills beyond DOUBLE_UP_TO: exact's walk from degree 13 on gfx1100
-(and 6 SGPRs of exact from 12 on both families), hessian's point form from 18 on gfx1100;
+Double (GLSL 450) still spills beyond DOUBLE_UP_TO: 6 SGPRs of exact from degree 12 on both
+families (no VGPR up to EXACT_DOUBLE_VGPRS_UP_TO, its own guard; T19 and T20 spill 7-9 VGPRs
+on gfx1100), hessian's point form from 18 on gfx1100;
 scripts/gpu_stats_table.py measures and lists it (docs/results-gpu.md, "What a GPU's
 compiler says").
 """
@@ -44,8 +45,8 @@ PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
 # 13 the peak was the tree route's power tables in ray_of, two registers a value: on gfx1100
 # exact, taylor and hessian spilled 9-35 VGPRs at T10-T12 until double took Horner's route
 # there (raypoly.DOUBLE_HORNER_FROM). exact at 12 keeps 6 spilled SGPRs (the Bernstein
-# sums' double constants, held through the walk) and from 13 its walk spills VGPRs on
-# gfx1100; hessian's point form spills from 18 there (docs/results-gpu.md).
+# sums' double constants, held through the walk; EXACT_DOUBLE_VGPRS_UP_TO guards its VGPRs
+# beyond); hessian's point form spills from 18 on gfx1100 (docs/results-gpu.md).
 DOUBLE = (("glsl", "450", "double"),)
 DOUBLE_UP_TO = {"exact": 11, "taylor": 20, "hessian": 17, "interval": 20}
 DOUBLE_DEGREES = (10, 11)
@@ -140,6 +141,30 @@ def test_exact_holds_few_registers(radv) -> None:
     over = [f"{key}: {stats.line()} (at most {bound})"
             for key, stats, bound in zip(keys, rows, bounds, strict=True) if stats.vgprs > bound]
     assert not over, "\n".join(over)
+
+
+# exact's double program (GLSL 450) spills no VGPR (no scratch) on RDNA2 and RDNA3 from
+# DOUBLE_UP_TO["exact"] + 1 up to EXACT_DOUBLE_VGPRS_UP_TO, but for ACO's 6 SGPRs (the
+# Bernstein sums' double constants, from degree 12). On gfx1100 (wave64, about 128 VGPRs)
+# the walk's node spilled 4-55 VGPRs (1-8 KB) at T13-T20 until Newton's start was computed
+# after the walk (solver.late_start), double's Horner route added each shifted
+# coefficient at once (raypoly._shifted_double), the sums ran from the middle out and the
+# touching root's u was set after the walk; T19 and T20 still spill 7-9.
+EXACT_DOUBLE_VGPRS_UP_TO = 18
+
+
+def test_exact_double_spills_no_vgpr(radv) -> None:
+    """exact's double program, Chmutov T_n from DOUBLE_UP_TO["exact"] + 1 to
+    EXACT_DOUBLE_VGPRS_UP_TO: no spilled VGPR and no scratch on RDNA2 and RDNA3."""
+    degrees = range(DOUBLE_UP_TO["exact"] + 1, EXACT_DOUBLE_VGPRS_UP_TO + 1)
+    target, flavor, precision = DOUBLE[0]
+    shaders = [implc.Surface(chmutov(n)).compile(target, "exact", flavor=flavor,
+                                                 precision=precision) for n in degrees]
+    spills = [f"chmutov {n} on {stats.line()}"
+              for rows in gpu_stats(shaders, GPU_FAMILIES).values()
+              for n, stats in zip(degrees, rows, strict=True)
+              if stats.spilled_vgprs or stats.scratch]
+    assert not spills, "\n".join(spills)
 
 
 def test_show_prints_the_statistics(radv) -> None:
