@@ -126,43 +126,19 @@ POLISH_STEPS = 2
 
 # Where the ray's coefficients come from S in Chebyshev's basis (float32 from ROBUST_NEWTON_BELOW,
 # implc/chebyshev.py), a node the walk would skip, or take as a root node, is decided again on F
-# re-expanded about its own middle (ray_of called there) when the expansion's middle lies outside
-# the node and an inner Bernstein coefficient is within RECENTER_ERR times the coefficients' own
-# error measured at the node's ends: |b_0 - F(a)| and |b_n - F(b)|, F there being S at the point,
-# which the walk computes anyway. Before it (the history below), the test was RECENTER_TOL = 1e-4
-# of the size of F's terms on the node (scale_at): the power series
-# about one point of the chord rounds to a share of its terms there (up to (1 + sqrt 2)^n times F's
-# size at T_n), and a skipped root pair is a first root missed. The first expansion is about
-# RECENTER_AT of the chord. Measured on gl at 256^2 against the certified reference, with the first
-# expansion about the first node's middle (bad pixels; docs/journal/2026-12-05-float32.md): Chmutov
-# T16 36 -> 1, T18 208 -> 6, T20 1,158 -> 20; with 1e-5 6, 21, 58 at about the same frame, with 1e-3
-# T18 2, T20 3 at 1.05-1.2x it. Each re-expansion is a ray_of (1,151-1,333 operations at T16-T18)
-# paid by the SIMD group of any lane that needs it: exact / taylor at 512^2 T16 0.70 -> 0.89, T17
-# 0.71 -> 0.89, T18 0.77 -> 0.91, T19 0.75 -> 0.85, T20 0.67 -> 0.66 (over issue 48's 0.67). Re-
-# expanding a root node in doubt as well (about the chord's middle): T20 15, 1.3x a frame.
-# These programs' Newton after the walk takes F' from the gradient at the point, not from the
-# ray's coefficients (whose rounding there is a share of terms about a far centre): on a wrong
-# slope it crept towards the root and stopped at NEWTON_STEPS short of it. At 512^2 on gl
-# (framed, the results page's view) T17-T20 19, 39, 64, 48 -> 1, 1, 5, 8 bad pixels (wgpu 0, 0,
-# 2, 9), T7-T16 unchanged; exact / taylor within -0.04..+0.07 of before at T14-T20, medians of
-# the differences 0.00-0.02 (2-4 runs, loaded machine; docs/journal/2026-12-05-float32.md).
-# A root node in doubt (one sign change of its coefficients, the same test as a skip's) is
-# re-expanded too: its one change may be three roots the rounding merged, and Newton took
-# the last. Chmutov at 192^2 on gl, the default view (not framed): T19 19 -> 1, T20 57 -> 9
-# bad pixels (3 of them false hits the double program has too); framed at 512^2 T18 1 -> 0,
-# the rest unchanged; exact / taylor at 512^2 T14-T20 0.49, 0.55, 0.60, 0.66, 0.70, 0.77, 0.64
-# -> 0.54, 0.60, 0.65, 0.74, 0.76, 0.80, 0.68 (one run, in turns, 7 frames).
-# RECENTER_TOL 3e-2 or 1e-1 would take T20's last 6 wrong roots there (skipped root pairs: the
-# coefficients' rounding is a share of the terms that made them, larger than scale_at says),
-# at exact / taylor 0.65-0.97 against 0.54-0.80: not kept (1e-2 leaves them).
-# Its ray_of is the walk's only one, at the top of each round (templates/solver.j2): RDNA2 80-96
-# VGPRs at T14-T20 where a second call site in the loop held 112-128 (docs/results-float32.md).
-# The measured error instead of scale_at's model: the same bad pixels at 512^2 framed on gl
-# (T14-T20 0, 1, 0, 1, 0, 2, 7: the last two the double program's false hits), T20 on the
-# default view at 192^2 9 -> 3 (those false hits), and far fewer re-expansions: exact / taylor
-# at 512^2 T14-T20 0.54, 0.60, 0.65, 0.73, 0.76, 0.80, 0.70 -> 0.45, 0.50, 0.52, 0.57, 0.60,
-# 0.63, 0.54 (the same run, in turns; issue 48's 0.67 met at every degree). 64 instead of 8:
-# the same pictures at 0.54-0.82 (both tests together: no better).
+# re-expanded about its own middle (ray_of called at the top of the walk's next round) when the
+# expansion's middle lies outside the node and an inner Bernstein coefficient is within
+# RECENTER_ERR times the coefficients' own error measured at the node's ends: |b_0 - F(a)| and
+# |b_n - F(b)|, F there being S at the point, which the walk computes anyway. The power series
+# about one point of the chord rounds to a share of its terms there (up to (1 + sqrt 2)^n times
+# F's size at T_n), and a root pair skipped is a first root missed; a root node's one sign change
+# may be three roots merged, and Newton took the last. These programs' Newton also takes F' from
+# the gradient at the point (on the coefficients' slope it stopped short of the root). Chmutov
+# T14-T20 at 512^2 (framed): 0-2 bad pixels on all six float32 renderers (and T20 the 7 false hits
+# the double program has too), against 25-1,027 with
+# one expansion; exact / taylor 0.43-0.65. The first test, 1e-4 of the size of F's terms on the
+# node (scale_at), re-expanded 44-65 % of the walking pixels (0.54-0.81) and still missed root
+# pairs on the default view; the history, measured: docs/results-float32.md.
 RECENTER_ERR = 8.0
 # The first expansion's centre, a share of the chord. At 512^2 on gl (bad pixels at
 # T14-T20, against the certified reference): 0.5 (the middle) 0, 1, 0, 19, 39, 62, 41;
