@@ -155,7 +155,7 @@ def _power_rows(c: float, h: float, top: int) -> list[list[tuple[int, float]]]:
         out = [0.0] * len(powers)
         for k, p in enumerate(powers):
             if p:
-                for j, q in enumerate(_monomial_in_chebyshev(k)):
+                for j, q in enumerate(map(float, monomial_in_chebyshev(k))):
                     if q:
                         out[j] += p * q
         rows.append([(j, v) for j, v in enumerate(out) if v])
@@ -163,12 +163,12 @@ def _power_rows(c: float, h: float, top: int) -> list[list[tuple[int, float]]]:
 
 
 @lru_cache(maxsize=64)
-def _monomial_in_chebyshev(k: int) -> tuple[float, ...]:
-    """t^k = sum_j q_j T_j(t): q_j = 2^(1-k) C(k, (k-j)/2) for j = k, k-2, ... (half that
-    at j = 0)."""
-    q = [0.0] * (k + 1)
+def monomial_in_chebyshev(k: int) -> tuple[sympy.Rational, ...]:
+    """t^k = sum_j q_j T_j(t), exactly: q_j = 2^(1-k) C(k, (k-j)/2) for j = k, k-2, ...
+    (half that at j = 0). Read, never changed (chebyshev.py's conversion uses it too)."""
+    q = [sympy.Rational(0)] * (k + 1)
     for j in range(k % 2, k + 1, 2):
-        q[j] = math.comb(k, (k - j) // 2) / 2.0 ** (k - 1 if j else k)
+        q[j] = sympy.Rational(math.comb(k, (k - j) // 2), 2 ** (k - 1 if j else k))
     return tuple(q)
 
 

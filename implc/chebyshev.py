@@ -26,12 +26,11 @@ well conditioned, keep their monomials)."""
 
 from __future__ import annotations
 
-import math
 from functools import lru_cache
 
 import sympy
 
-from .box_choice import Box, choose_box
+from .box_choice import Box, choose_box, monomial_in_chebyshev
 from .derive import expanded_terms
 from .optimize import Program, count_ops
 from .symbols import DIRECTION, POINT
@@ -118,22 +117,12 @@ def tensor_coefficients(terms: dict, box) -> dict[tuple[int, int, int], sympy.Ra
     return {m: sympy.Rational(b) for m, b in sorted(shifted.items()) if b != 0}
 
 
-@lru_cache(maxsize=64)
-def _monomial_in_chebyshev(k: int) -> tuple[sympy.Rational, ...]:
-    """X^k = sum_j q_j T_j(X): q_j = 2^(1-k) C(k, (k-j)/2) for j = k, k-2, ... (half that
-    at j = 0)."""
-    q = [sympy.Rational(0)] * (k + 1)
-    for j in range(k % 2, k + 1, 2):
-        q[j] = sympy.Rational(math.comb(k, (k - j) // 2), 2 ** (k - 1 if j else k))
-    return tuple(q)
-
-
 def _chebyshev_of(power_coefficients: list) -> list:
     """The Chebyshev coefficients of sum p_k X^k (lowest first)."""
     out = [sympy.Rational(0)] * len(power_coefficients)
     for k, p in enumerate(power_coefficients):
         if p:
-            for j, q in enumerate(_monomial_in_chebyshev(k)):
+            for j, q in enumerate(monomial_in_chebyshev(k)):
                 out[j] += p * q
     return out
 

@@ -35,6 +35,7 @@ from .plain_extent import (
     SHIFT,
     SHRINKING,
     SPHERE_SAMPLES,
+    length_quantum,
 )
 from .scene import Extent, Vec3
 from .symbols import POINT
@@ -91,7 +92,7 @@ def _clear_of_sphere(expr: sympy.Expr, extent: Extent) -> Extent:
     if radius == extent.radius:
         return extent
     radius *= MARGIN
-    quantum = _quantum(radius)
+    quantum = length_quantum(radius)
     return Extent(extent.center, round(math.ceil(radius / quantum - 1e-9) * quantum, 12),
                   bounded=True)
 
@@ -116,7 +117,7 @@ def longest_period(expr: sympy.Expr) -> float:
         longest = max(longest, (math.pi if node.func is sympy.tan else 2 * math.pi) / norm)
     if longest == 0.0:
         return 0.0
-    quantum = _quantum(longest)
+    quantum = length_quantum(longest)
     return round(math.ceil(longest / quantum - 1e-9) * quantum, 12)
 
 
@@ -135,20 +136,15 @@ def _bounded(expr: sympy.Expr, points: np.ndarray, spacing: float,
     if center is None:
         middle = (points.min(axis=0) + points.max(axis=0)) / 2.0
         reach = float(np.linalg.norm(points - middle, axis=1).max())
-        quantum = _quantum(reach)
+        quantum = length_quantum(reach)
         middle = np.round(middle / quantum) * quantum + 0.0  # + 0.0: no -0.0
     else:
         middle = np.asarray(center, dtype=np.float64)
     reach = float(np.linalg.norm(points - middle, axis=1).max())
     radius = MARGIN * reach + spacing
-    quantum = _quantum(radius)
+    quantum = length_quantum(radius)
     radius = math.ceil(radius / quantum - 1e-9) * quantum
     return Extent(_vec3(np.round(middle, 12) + 0.0), round(radius, 12), bounded=True)
-
-
-def _quantum(length: float) -> float:
-    """The rounding step of a length: two significant digits."""
-    return 10.0 ** (math.floor(math.log10(max(length, 1e-12))) - 1)
 
 
 def sign_changes(expr: sympy.Expr, center: np.ndarray,

@@ -66,10 +66,10 @@ def _bounded(expr: sympy.Expr, points: list[Point], spacing: float) -> tuple[Poi
         points, spacing = fine, fine_spacing
     middle = tuple((min(p[a] for p in points) + max(p[a] for p in points)) / 2.0
                    for a in range(3))
-    quantum = _quantum(_reach(points, middle))
+    quantum = length_quantum(_reach(points, middle))
     middle = tuple(round(m / quantum) * quantum + 0.0 for m in middle)
     radius = MARGIN * _reach(points, middle) + spacing
-    quantum = _quantum(radius)
+    quantum = length_quantum(radius)
     radius = math.ceil(radius / quantum - 1e-9) * quantum
     return tuple(_round12(m) + 0.0 for m in middle), round(radius, 12)
 
@@ -97,11 +97,12 @@ def _clear_of_sphere(expr: sympy.Expr, center: Point, radius: float) -> tuple[Po
     if grown == radius:
         return center, radius
     grown *= MARGIN
-    quantum = _quantum(grown)
+    quantum = length_quantum(grown)
     return center, round(math.ceil(grown / quantum - 1e-9) * quantum, 12)
 
 
-def _quantum(length: float) -> float:
+def length_quantum(length: float) -> float:
+    """The rounding step of a length: two significant digits (extent.py's too)."""
     return 10.0 ** (math.floor(math.log10(max(length, 1e-12))) - 1)
 
 
