@@ -253,7 +253,7 @@ def lower(method: Method, constants: Constants, expr: sympy.Expr, form: str, pri
         return printer.doprint(expr.xreplace(const_names))
 
     wanted = evaluations(method, form)
-    programs = build_programs(expr, point_sets(method, form), max_derived)
+    programs = build_programs(expr, point_sets(method, form), max_derived, printer.precision)
     functions = [point_function(name, program, printer, carried)
                  for name, program in programs.items()]
     fields, ray = (), PrintedBody((), ())  # the point form's ray record: o, d and sm only

@@ -11,6 +11,10 @@ Four passes, all deterministic:
    terms allow;
 4. op counting with one cost model, before (each output alone, powers as repeated
    multiplication) and after (the optimized program), so `implc show` can report both.
+
+In double (`by_axis`) a pass between 2 and 3 sums each output's terms per axis and puts
+every statement after its axis's powers, so that x's powers are dead before y's are made
+(`_by_axis`: a register-file's worth on a GPU, where a double takes two registers).
 """
 
 from __future__ import annotations
@@ -34,8 +38,10 @@ class Program:
     ops_after: int
 
 
-def optimize(outputs: Sequence[sympy.Expr], inputs: Sequence[sympy.Symbol]) -> Program:
-    """Jointly CSE `outputs`, rewrite integer powers as products and count operations."""
+def optimize(outputs: Sequence[sympy.Expr], inputs: Sequence[sympy.Symbol],
+             by_axis: bool = False) -> Program:
+    """Jointly CSE `outputs`, rewrite integer powers as products and count operations;
+    with `by_axis`, summed and ordered axis by axis (`_by_axis`)."""
     outputs = tuple(outputs)
     inputs = tuple(inputs)
     before = sum(count_ops(o) for o in outputs)
@@ -45,6 +51,8 @@ def optimize(outputs: Sequence[sympy.Expr], inputs: Sequence[sympy.Symbol]) -> P
     assignments, reduced = _drop_aliases(assignments, reduced)
     assignments, reduced, powers = _renumber(assignments, reduced, powers)
     assignments = _insert_power_chains(assignments, powers, inputs)
+    if by_axis:
+        assignments, reduced = _by_axis(assignments, reduced, inputs)
     assignments, reduced = _sums_by_depth(assignments, reduced, inputs)
     after = sum(count_ops(v) for _, v in assignments) + sum(count_ops(o) for o in reduced)
     return Program(inputs, tuple(assignments), tuple(reduced), before, after)
@@ -153,6 +161,49 @@ def _power_chain(base: sympy.Symbol, exponents: set[int]):
     for n in sorted(exponents):
         build(n)
     return chain
+
+
+def _by_axis(assignments, outputs, inputs):
+    """Each output's terms summed per axis, the statements ordered axis by axis.
+
+    Input k is on axis k mod 3 (x, y, z, then dx, dy, dz); a statement or term is on the
+    last axis it reads (-1: none). Each output that is a sum of terms on several axes
+    becomes the sum of its parts, part<output>_<axis> (axis 1-3), and every statement
+    moves, in its order, after those of lower axes: x's powers, what reads only x, then
+    y's powers, ... A statement is never on a lower axis than one it reads, so this order
+    keeps every definition before its uses. Written as a balanced sum of all terms, S of
+    Chmutov's T_20 held the powers x^2..x^20 of all three axes at once, and in double
+    RDNA3 spilled hessian's program at degree 18-20 (2-9 VGPRs; RDNA2 held 136-144, now
+    96-104). The operations are the same."""
+    key: dict[sympy.Symbol, int] = {s: k % 3 for k, s in enumerate(inputs)}
+
+    def axis_of(expr: sympy.Expr) -> int:
+        return max((key.get(s, -1) for s in expr.free_symbols), default=-1)
+
+    for sym, value in assignments:
+        key[sym] = axis_of(value)
+    parts = []
+    new_outputs = []
+    for k, output in enumerate(outputs):
+        groups: dict[int, list[sympy.Expr]] = {}
+        for term in sympy.Add.make_args(output):
+            groups.setdefault(axis_of(term), []).append(term)
+        if len(groups) < 2:
+            new_outputs.append(output)
+            continue
+        summed = []
+        for axis, terms in sorted(groups.items()):
+            if len(terms) == 1 and terms[0].is_Atom:
+                summed.append(terms[0])
+                continue
+            part = sympy.Symbol(f"part{k}_{axis + 1}", real=True)
+            key[part] = axis
+            parts.append((part, sympy.Add(*terms)))
+            summed.append(part)
+        new_outputs.append(sympy.Add(*summed))
+    lets = list(assignments) + parts
+    order = sorted(range(len(lets)), key=lambda j: (key[lets[j][0]], j))
+    return [lets[j] for j in order], new_outputs
 
 
 def _sums_by_depth(assignments, outputs, inputs):

@@ -96,20 +96,22 @@ class IntervalMarching(Marcher):
 # --- derivation (cached: emit asks for the same programs for every target) -----------
 
 def build_programs(expr: sympy.Expr, sets: tuple[tuple[str, ...], ...],
-                   max_derived: int) -> dict[str, Program]:
-    """The optimized Program of each point quantity set."""
-    return dict(_build_programs(expr, sets, max_derived))
+                   max_derived: int, precision: str = "float") -> dict[str, Program]:
+    """The optimized Program of each point quantity set, for a shader in `precision`: in
+    double summed axis by axis (optimize's `by_axis`: two registers a value)."""
+    return dict(_build_programs(expr, sets, max_derived, precision == "double"))
 
 
 @lru_cache(maxsize=64)
-def _build_programs(expr, sets, max_derived) -> tuple[tuple[str, Program], ...]:
+def _build_programs(expr, sets, max_derived, by_axis) -> tuple[tuple[str, Program], ...]:
     derivatives = Derivatives(expr, max_derived)
     result = []
     for quantities in sets:
         outputs = [e for q in quantities for e in derivatives.quantity(q)]
         directional = any(q in ("dS", "d2S") for q in quantities)
         result.append((function_name(quantities),
-                       optimize(outputs, POINT + DIRECTION if directional else POINT)))
+                       optimize(outputs, POINT + DIRECTION if directional else POINT,
+                                by_axis)))
     return tuple(result)
 
 

@@ -317,7 +317,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
     F, a degree-k polynomial in u = t - sm: by Estrin's scheme for k < n (the Newton loops
     that place the critical points are bound by their chains: 7 % a frame on the quartics,
     29 % at degree 12), F itself too, with the rounding bound ROUND_ERR states."""
-    programs = build_programs(expr, (("S",), ("grad",)), max_derived)
+    programs = build_programs(expr, (("S",), ("grad",)), max_derived, printer.precision)
     chebyshev = _chebyshev(expr, printer.precision, ray=False)
     if chebyshev is not None:  # where float32 cannot hold S's monomials
         programs["S"] = chebyshev
