@@ -168,7 +168,8 @@ def _by_axis(assignments, outputs, inputs):
 
     Input k is on axis k mod 3 (x, y, z, then dx, dy, dz); a statement or term is on the
     last axis it reads (-1: none). Each output that is a sum of terms on several axes
-    becomes the sum of its parts, part<output>_<axis> (axis 1-3), and every statement
+    becomes the sum of its parts, part<output>_<axis> (axis 1-3; each output of several,
+    as grad's components on one axis each, is its parts too), and every statement
     moves, in its order, after those of lower axes: x's powers, what reads only x, then
     y's powers, ... A statement is never on a lower axis than one it reads, so this order
     keeps every definition before its uses. Written as a balanced sum of all terms, S of
@@ -188,7 +189,7 @@ def _by_axis(assignments, outputs, inputs):
         groups: dict[int, list[sympy.Expr]] = {}
         for term in sympy.Add.make_args(output):
             groups.setdefault(axis_of(term), []).append(term)
-        if len(groups) < 2:
+        if len(groups) < 2 and len(outputs) < 2:  # nothing to order
             new_outputs.append(output)
             continue
         summed = []

@@ -13,8 +13,8 @@ The occupancy guard: exact holds at most EXACT_VGPRS_BELOW VGPRs on RDNA2 below 
 13 and EXACT_VGPRS from there (Chmutov's and the bundled surfaces).
 
 Double (GLSL 450) still spills beyond DOUBLE_UP_TO: 6 SGPRs of exact from degree 12 on both
-families (no VGPR up to EXACT_DOUBLE_VGPRS_UP_TO, its own guard; T19 and T20 spill 7-9 VGPRs
-on gfx1100), hessian's point form from 18 on gfx1100;
+families (no VGPR up to EXACT_DOUBLE_VGPRS_UP_TO, its own guard; T19 and T20 spill 5-9 VGPRs
+on gfx1100);
 scripts/gpu_stats_table.py measures and lists it (docs/results-gpu.md, "What a GPU's
 compiler says").
 """
@@ -46,9 +46,10 @@ PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
 # exact, taylor and hessian spilled 9-35 VGPRs at T10-T12 until double took Horner's route
 # there (raypoly.DOUBLE_HORNER_FROM). exact at 12 keeps 6 spilled SGPRs (the Bernstein
 # sums' double constants, held through the walk; EXACT_DOUBLE_VGPRS_UP_TO guards its VGPRs
-# beyond); hessian's point form spills from 18 on gfx1100 (docs/results-gpu.md).
+# beyond). hessian's point form spilled 2-9 VGPRs at 18-20 on gfx1100 until double's point
+# functions were summed axis by axis (optimize._by_axis; docs/results-gpu.md).
 DOUBLE = (("glsl", "450", "double"),)
-DOUBLE_UP_TO = {"exact": 11, "taylor": 20, "hessian": 17, "interval": 20}
+DOUBLE_UP_TO = {"exact": 11, "taylor": 20, "hessian": 20, "interval": 20}
 DOUBLE_DEGREES = (10, 11)
 # and one known spill: Barth's decic's interval program in double spills 13 VGPRs on gfx1100
 DOUBLE_SPILLS = (("barth-decic", "interval"),)
