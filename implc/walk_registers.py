@@ -34,9 +34,9 @@ class WalkRegisters:
     # (late_start) the control polygon's pair with the sign change kept through the sums
     # by its index i, an int, and its w_(i-1) chosen after them
     control_index: bool = False
-    # a descent's width scaled by ldexp, not by a select of 2^-L's double constants (one
-    # of which was held in a VGPR through the walk)
-    ldexp_descent: bool = False
+    # (pos_unit) a descent's width shifted in units of pos_unit, not scaled by a select of
+    # 2^-L's double constants (one of which was held in a VGPR through the walk)
+    descent_by_shift: bool = False
 
 
 def walk_registers(precision: str, recenter: bool, float_literal) -> WalkRegisters:

@@ -149,10 +149,10 @@ def test_exact_holds_few_registers(radv) -> None:
 # the walk's node spilled 4-55 VGPRs (1-8 KB) at T13-T20 until Newton's start was computed
 # after the walk (solver.late_start), double's Horner route added each shifted
 # coefficient at once (raypoly._shifted_double), the sums ran from the middle out and the
-# touching root's u was set after the walk; T19 and T20 spilled 5-9 until S and its
-# gradient at the chord's start came before ray_of, the node's start was index*width, F's
-# ends were carried as signs, the control polygon's pair by its index and a descent's width
-# by ldexp (solver.start_first, pos_of_index, end_signs, control_index, halving_descent).
+# touching root's u was set after the walk; T19 and T20 spilled 5-9 until the walk held
+# its values in fewer registers (implc/walk_registers.py: S and its gradient at the
+# chord's start before ray_of, the node's start an int, F's ends as signs, the control
+# polygon's pair by its index, a descent's width by a shift).
 EXACT_DOUBLE_VGPRS_UP_TO = 20
 
 
