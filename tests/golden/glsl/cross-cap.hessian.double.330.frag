@@ -67,12 +67,16 @@ dvec3 grad(dvec3 p) {
     double z = p.z;
     double x_2 = x*x;
     double x_3 = x*x_2;
+    double part0_1 = 8.0lf*x_3;
     double y_2 = y*y;
     double y_3 = y*y_2;
+    double part1_2 = 8.0lf*x_2*y + 2.0lf*y_3;
     double z_2 = z*z;
     double t0 = y_2 + z_2;
     double t1 = 2.0lf*z;
-    return dvec3(8.0lf*x*(t0 + (x_2 + z)) + 8.0lf*x_3, 2.0lf*y*(t0 - 1.0lf) + (8.0lf*x_2*y + 2.0lf*y_3), t1*y_2 + 4.0lf*x_2*(t1 + 1.0lf));
+    double part0_3 = 8.0lf*x*(t0 + (x_2 + z));
+    double part1_3 = 2.0lf*y*(t0 - 1.0lf);
+    return dvec3(part0_1 + part0_3, part1_2 + part1_3, t1*y_2 + 4.0lf*x_2*(t1 + 1.0lf));
 }
 
 // dS, d2S at march parameter s: Estrin's scheme on the ray polynomial

@@ -66,12 +66,16 @@ double3 grad(double3 p) {
     double z = p.z;
     double x_2 = x*x;
     double x_3 = x*x_2;
+    double part0_1 = 8.0*x_3;
     double y_2 = y*y;
     double y_3 = y*y_2;
+    double part1_2 = 8.0*x_2*y + 2.0*y_3;
     double z_2 = z*z;
     double t0 = y_2 + z_2;
     double t1 = 2.0*z;
-    return (double3)(8.0*x*(t0 + (x_2 + z)) + 8.0*x_3, 2.0*y*(t0 - 1.0) + (8.0*x_2*y + 2.0*y_3), t1*y_2 + 4.0*x_2*(t1 + 1.0));
+    double part0_3 = 8.0*x*(t0 + (x_2 + z));
+    double part1_3 = 2.0*y*(t0 - 1.0);
+    return (double3)(part0_1 + part0_3, part1_2 + part1_3, t1*y_2 + 4.0*x_2*(t1 + 1.0));
 }
 
 // P1 = F''', degree 1 in u = t - sm
