@@ -35,6 +35,7 @@ from .raypoly import (
     horner,
     ray_setup,
 )
+from .walk_registers import WalkRegisters, walk_registers
 
 # From this degree the exact method isolates F's first root by Bernstein subdivision
 # (Descartes' rule of signs on the Bernstein coefficients of a node, stackless: the next
@@ -213,6 +214,8 @@ class Solver:
     # bernstein: Newton's start computed after the walk from the root node's coefficients
     # again, not kept through it (double: RDNA3 spilled the walk from degree 13)
     late_start: bool = False
+    # bernstein: the walk's values held in fewer registers (double; implc/walk_registers.py)
+    registers: WalkRegisters = WalkRegisters()
 
 
 @dataclass(frozen=True)
@@ -390,7 +393,9 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         else 0,
                         *((printer.float_literal(RECENTER_ERR),
                            printer.float_literal(RECENTER_AT)) if recenter
-                          else ()), late_start=printer.precision == "double")
+                          else ()), late_start=printer.precision == "double",
+                        registers=walk_registers(printer.precision, recenter,
+                                                 printer.float_literal))
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(

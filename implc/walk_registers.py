@@ -1,0 +1,49 @@
+"""The Bernstein walk's register switches (templates/solver.j2, `exact` from
+BERNSTEIN_FROM): in double a value takes two registers, and on RDNA3 (gfx1100, about 126
+VGPRs a wave64 holds without spilling) the walk of Chmutov's T19-T20 spilled 5-9 VGPRs to
+scratch until all of these held (tests/test_gpu_stats.py); each keeps the program's
+values bit for bit. Float's programs take none of them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# the walk's node start, an int in units of 2^-POS_BITS: a width is at least 2^-WIDTH_BITS
+# there (a descent stops at 2^-(BERNSTEIN_DEPTH + 3); only the next node's narrowing went
+# further, on a ray that nearly touches the surface, and stops there)
+POS_BITS = 30
+WIDTH_BITS = 26
+
+
+@dataclass(frozen=True)
+class WalkRegisters:
+    """Which of the walk's values the program holds in fewer registers, and how."""
+
+    # S and its gradient at the chord's start before ray_of, not after it (F's n + 1
+    # coefficients were held with the point's powers: T20 134 VGPRs on RDNA2)
+    start_first: bool = False
+    # the node's start an int ipos in units of pos_unit (2^-POS_BITS printed; pos_units,
+    # its inverse, as a real and as an int), not a double pos and an int index
+    pos_unit: str = ""
+    pos_units: str = ""
+    pos_units_int: str = ""
+    width_floor: str = ""  # 2^-WIDTH_BITS printed
+    # F at a node's ends carried as its sign (an int -1, 0, 1): the walk and Newton read
+    # no more of it
+    end_signs: bool = False
+    # (late_start) the control polygon's pair with the sign change kept through the sums
+    # by its index i, an int, and its w_(i-1) chosen after them
+    control_index: bool = False
+    # (pos_unit) a descent's width shifted in units of pos_unit, not scaled by a select of
+    # 2^-L's double constants (one of which was held in a VGPR through the walk)
+    descent_by_shift: bool = False
+
+
+def walk_registers(precision: str, recenter: bool, float_literal) -> WalkRegisters:
+    """All the switches in double (start_first and end_signs where F is expanded once,
+    about the chord's middle), none in float."""
+    if precision != "double":
+        return WalkRegisters()
+    return WalkRegisters(not recenter, float_literal(2.0 ** -POS_BITS),
+                         float_literal(2.0 ** POS_BITS), str(2 ** POS_BITS),
+                         float_literal(2.0 ** -WIDTH_BITS), not recenter, True, True)
