@@ -433,7 +433,11 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
     beta_(n-i),k = (-1)^k beta_ik: the even part (k even) and the odd part are summed once
     for i <= n/2 and give b_i and b_(n-i) by a sum and a difference; in double from the
     middle out (b_n, b_(n-1), read after the sums, are made last: 4 VGPRs fewer held
-    through them). With each let, the pairs (b_(j-1), b_j) by j it completes."""
+    through them). In double the odd part is summed negated (its first term, e_1's, is then
+    positive; printed negative, it became a constant of its own, held in 2 SGPRs through
+    the walk by AMD's compiler: 6 SGPRs spilled at degrees 12-13 on RDNA2/RDNA3), and
+    b_i, b_(n-i) are its difference and sum: the same values, bit for bit. With each let,
+    the pairs (b_(j-1), b_j) by j it completes."""
     lets: list[tuple[str, str, tuple[int, ...]]] = []
     known: set[int] = set()
 
@@ -447,9 +451,11 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
         if odd is None:  # the middle coefficient
             coefficient(i, printer.doprint(even))
             continue
-        lets += [(f"be{i}", printer.doprint(even), ()), (f"bo{i}", printer.doprint(odd), ())]
-        coefficient(i, f"be{i} + bo{i}")
-        coefficient(n - i, f"be{i} - bo{i}")
+        sign, other = ("-", "+") if printer.precision == "double" else ("+", "-")
+        lets += [(f"be{i}", printer.doprint(even), ()),
+                 (f"bo{i}", printer.doprint(-odd if sign == "-" else odd), ())]
+        coefficient(i, f"be{i} {sign} bo{i}")
+        coefficient(n - i, f"be{i} {other} bo{i}")
     return tuple(lets)
 
 

@@ -37,6 +37,14 @@ class WalkRegisters:
     # (pos_unit) a descent's width shifted in units of pos_unit, not scaled by a select of
     # 2^-L's double constants (one of which was held in a VGPR through the walk)
     descent_by_shift: bool = False
+    # how the walk ended, an int `stop` (0 no root, 1 a root, 2 a leaf to test, 3 a touching
+    # leaf; a root at a node's start is the one with fl = 0), not the bools found, leaf and
+    # touch: set at the loops' breaks, each was a lane mask ACO carried through the walk's
+    # loops in SGPRs (RDNA2/RDNA3, T14-T15: SGPRs spilled)
+    exit_code: bool = False
+    # (descent_by_shift) a descent's levels an int chosen right after the sums, not from
+    # the cross_i at the descent: those were held as lane masks from the sums to it
+    descent_int: bool = False
 
 
 def walk_registers(precision: str, recenter: bool, float_literal) -> WalkRegisters:
@@ -46,4 +54,4 @@ def walk_registers(precision: str, recenter: bool, float_literal) -> WalkRegiste
         return WalkRegisters()
     return WalkRegisters(not recenter, float_literal(2.0 ** -POS_BITS),
                          float_literal(2.0 ** POS_BITS), str(2 ** POS_BITS),
-                         float_literal(2.0 ** -WIDTH_BITS), not recenter, True, True)
+                         float_literal(2.0 ** -WIDTH_BITS), not recenter, True, True, True, True)
