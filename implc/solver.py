@@ -394,8 +394,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         *((printer.float_literal(RECENTER_ERR),
                            printer.float_literal(RECENTER_AT)) if recenter
                           else ()), late_start=printer.precision == "double",
-                        registers=walk_registers(printer.precision, recenter,
-                                                 printer.float_literal))
+                        registers=walk_registers(printer.precision, printer.float_literal))
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(
@@ -440,6 +439,7 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
     the pairs (b_(j-1), b_j) by j it completes."""
     lets: list[tuple[str, str, tuple[int, ...]]] = []
     known: set[int] = set()
+    negated = printer.precision == "double"  # the odd part summed negated
 
     def coefficient(i: int, value: str) -> None:
         # after b_i, the pairs (b_(j-1), b_j) it completes, j in (i, i + 1)
@@ -451,11 +451,10 @@ def bernstein_lets(n: int, printer) -> tuple[tuple[str, str, tuple[int, ...]], .
         if odd is None:  # the middle coefficient
             coefficient(i, printer.doprint(even))
             continue
-        sign, other = ("-", "+") if printer.precision == "double" else ("+", "-")
         lets += [(f"be{i}", printer.doprint(even), ()),
-                 (f"bo{i}", printer.doprint(-odd if sign == "-" else odd), ())]
-        coefficient(i, f"be{i} {sign} bo{i}")
-        coefficient(n - i, f"be{i} {other} bo{i}")
+                 (f"bo{i}", printer.doprint(-odd if negated else odd), ())]
+        coefficient(i, f"be{i} - bo{i}" if negated else f"be{i} + bo{i}")
+        coefficient(n - i, f"be{i} + bo{i}" if negated else f"be{i} - bo{i}")
     return tuple(lets)
 
 

@@ -47,11 +47,15 @@ class WalkRegisters:
     descent_int: bool = False
 
 
-def walk_registers(precision: str, recenter: bool, float_literal) -> WalkRegisters:
-    """All the switches in double (start_first and end_signs where F is expanded once,
-    about the chord's middle), none in float."""
+def walk_registers(precision: str, float_literal) -> WalkRegisters:
+    """All the switches in double, none in float (double's F is expanded once, about the
+    chord's middle: it never re-expands, so S at the chord's start can come first)."""
     if precision != "double":
         return WalkRegisters()
-    return WalkRegisters(not recenter, float_literal(2.0 ** -POS_BITS),
-                         float_literal(2.0 ** POS_BITS), str(2 ** POS_BITS),
-                         float_literal(2.0 ** -WIDTH_BITS), not recenter, True, True, True, True)
+    return WalkRegisters(start_first=True,
+                         pos_unit=float_literal(2.0 ** -POS_BITS),
+                         pos_units=float_literal(2.0 ** POS_BITS),
+                         pos_units_int=str(2 ** POS_BITS),
+                         width_floor=float_literal(2.0 ** -WIDTH_BITS),
+                         end_signs=True, control_index=True, descent_by_shift=True,
+                         exit_code=True, descent_int=True)
