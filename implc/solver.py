@@ -394,7 +394,8 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
                         *((printer.float_literal(RECENTER_ERR),
                            printer.float_literal(RECENTER_AT)) if recenter
                           else ()), late_start=printer.precision == "double",
-                        registers=walk_registers(printer.precision, printer.float_literal))
+                        registers=walk_registers(printer.precision, printer.float_literal,
+                                                  NEXT_FLOOR))
         if not robust_newton:
             value, powers = estrin(c, u)
             functions.append(ShaderFunction(

@@ -1,8 +1,11 @@
 """The Bernstein walk's register switches (templates/solver.j2, `exact` from
 BERNSTEIN_FROM): in double a value takes two registers, and on RDNA3 (gfx1100, about 126
 VGPRs a wave64 holds without spilling) the walk of Chmutov's T19-T20 spilled 5-9 VGPRs to
-scratch until all of these held (tests/test_gpu_stats.py); each keeps the program's
-values bit for bit. Float's programs take none of them."""
+scratch until all of these held, and T12-T18 spilled 2-6 SGPRs into a VGPR's lanes
+(tests/test_gpu_stats.py). Each keeps the program's values bit for bit but
+inline_constants, whose node middle is exact where nm/nr rounded and whose `reach` is
+compared as a product: exact's pictures in double (gl-double, cl-double) stayed
+bit-identical in hit, t and steps. Float's programs take none of them."""
 
 from __future__ import annotations
 
@@ -45,11 +48,23 @@ class WalkRegisters:
     # (descent_by_shift) a descent's levels an int chosen right after the sums, not from
     # the cross_i at the descent: those were held as lane masks from the sums to it
     descent_int: bool = False
+    # (pos_unit) no double constant in the walk's loop that AMD cannot encode inline (0.5,
+    # 1, 2 and 4 it can): each such constant ACO held in 2 SGPRs through the walk (RDNA2/
+    # RDNA3, T16-T18: SGPRs spilled). A division is AMD's software reciprocal, 4 constants:
+    # the node's middle in half widths, nm/nr = (2 pos - 1 + width)/width (lo = -span/2),
+    # is made exactly from ipos and width's exponent (frexp, ldexp: width is a power of
+    # two), and `reach` is compared as a product; 1/NEXT_FLOOR (0.25) is `floor_halvings`
+    # halvings.
+    inline_constants: bool = False
+    floor_halvings: int = 0
 
 
-def walk_registers(precision: str, float_literal) -> WalkRegisters:
+def walk_registers(precision: str, float_literal, next_floor: int) -> WalkRegisters:
     """All the switches in double, none in float (double's F is expanded once, about the
-    chord's middle: it never re-expands, so S at the chord's start can come first)."""
+    chord's middle: it never re-expands, so S at the chord's start can come first);
+    `next_floor`: solver.NEXT_FLOOR, a power of two."""
+    if next_floor & (next_floor - 1):
+        raise ValueError(f"NEXT_FLOOR {next_floor} is not a power of two")
     if precision != "double":
         return WalkRegisters()
     return WalkRegisters(start_first=True,
@@ -58,4 +73,5 @@ def walk_registers(precision: str, float_literal) -> WalkRegisters:
                          pos_units_int=str(2 ** POS_BITS),
                          width_floor=float_literal(2.0 ** -WIDTH_BITS),
                          end_signs=True, control_index=True, descent_by_shift=True,
-                         exit_code=True, descent_int=True)
+                         exit_code=True, descent_int=True, inline_constants=True,
+                         floor_halvings=next_floor.bit_length() - 1)

@@ -12,7 +12,7 @@ each method's DOUBLE_UP_TO. `make test` samples degrees
 The occupancy guard: exact holds at most EXACT_VGPRS_BELOW VGPRs on RDNA2 below degree
 13 and EXACT_VGPRS from there (Chmutov's and the bundled surfaces).
 
-Double (GLSL 450) still spills beyond DOUBLE_UP_TO: 2-6 SGPRs of exact from degree 16 on both
+Double (GLSL 450) still spills beyond DOUBLE_UP_TO: 6 SGPRs of exact at degrees 19-20 on both
 families (no VGPR up to EXACT_DOUBLE_VGPRS_UP_TO, its own guard);
 scripts/gpu_stats_table.py measures and lists it (docs/results-gpu.md, "What a GPU's
 compiler says").
@@ -40,7 +40,7 @@ ROOT = Path(__file__).resolve().parent.parent
 # the float programs that reach SPIR-V: (target, flavour, precision)
 PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
 # double (GLSL 450): each method's program guarded up to this degree (on the sampled
-# degrees, 10, 11 and 13-15 added, and the bundled surfaces of that degree or less).
+# degrees, 10, 11, 13-15, 17 and 18 added, and the bundled surfaces of that degree or less).
 # Below degree 13 the peak was the tree route's power tables in ray_of, two registers a
 # value: on gfx1100 exact, taylor and hessian spilled 9-35 VGPRs at T10-T12 until double
 # took Horner's route there (raypoly.DOUBLE_HORNER_FROM). exact spilled 6 SGPRs from 12
@@ -48,13 +48,15 @@ PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
 # through its loops, and spills the exec masks of the ifs around them into a VGPR's
 # lanes) until the sums' odd part was summed negated (T12-T13: no constant of its own for
 # e_1's negative weight), the walk's end became an int and a descent's levels an int
-# chosen after the sums (walk_registers.WalkRegisters.exit_code, descent_int; T14-T15);
-# it still spills 2-6 from 16 (EXACT_DOUBLE_VGPRS_UP_TO guards its VGPRs beyond).
+# chosen after the sums (walk_registers.WalkRegisters.exit_code, descent_int; T14-T15),
+# and the walk's loop held no double constant AMD cannot encode inline (inline_constants:
+# no division, a division being AMD's software reciprocal with 4 constants; T16-T18);
+# it still spills 6 at 19-20 (EXACT_DOUBLE_VGPRS_UP_TO guards its VGPRs beyond).
 # hessian's point form spilled 2-9 VGPRs at 18-20 on gfx1100 until double's point
 # functions were summed axis by axis (optimize._by_axis; docs/results-gpu.md).
 DOUBLE = (("glsl", "450", "double"),)
-DOUBLE_UP_TO = {"exact": 15, "taylor": 20, "hessian": 20, "interval": 20}
-DOUBLE_DEGREES = (10, 11, 13, 14, 15)
+DOUBLE_UP_TO = {"exact": 18, "taylor": 20, "hessian": 20, "interval": 20}
+DOUBLE_DEGREES = (10, 11, 13, 14, 15, 17, 18)
 # and one known spill: Barth's decic's interval program in double spills 13 VGPRs on gfx1100
 DOUBLE_SPILLS = (("barth-decic", "interval"),)
 
@@ -149,8 +151,8 @@ def test_exact_holds_few_registers(radv) -> None:
 
 
 # exact's double program (GLSL 450) spills no VGPR (no scratch) on RDNA2 and RDNA3 from
-# DOUBLE_UP_TO["exact"] + 1 up to EXACT_DOUBLE_VGPRS_UP_TO, but for ACO's 2-6 SGPRs (the
-# walk's double constants, from degree 16). On gfx1100 (wave64, about 128 VGPRs)
+# DOUBLE_UP_TO["exact"] + 1 up to EXACT_DOUBLE_VGPRS_UP_TO, but for ACO's 6 SGPRs (the
+# walk's double constants, at degrees 19-20). On gfx1100 (wave64, about 128 VGPRs)
 # the walk's node spilled 4-55 VGPRs (1-8 KB) at T13-T20 until Newton's start was computed
 # after the walk (solver.late_start), double's Horner route added each shifted
 # coefficient at once (raypoly._shifted_double), the sums ran from the middle out and the
