@@ -4,7 +4,7 @@ Python decides what to compute (derive, optimize, implc/marcher.py's lowering of
 method) and prints every expression and number; templates hold all shader text, and the
 only arithmetic they write is the algorithms' own, fixed for every surface (the march
 loop, Newton-bisection, the exact solver's quadratic formula, Newton and Halley steps and
-Bernstein walk in templates/solver.j2). templates/marcher.j2 is the marcher skeleton of
+Bernstein walk in templates/solver/walk.j2). templates/marcher.j2 is the marcher skeleton of
 every target, spelled by templates/<target>/lang.j2, inside the target's program or
 library frame. Rendering is strict: a name a template uses but emit does not give is an
 error, not an empty string.

@@ -44,7 +44,7 @@ from .walk_registers import WalkRegisters, walk_registers
 # of every derivative. Measured at 512^2 (docs/journal/2026-12-02-every-degree.md), exact / taylor:
 # degree 5-6 with the levels 0.84-1.03 (Taubin's heart, Barth's sextic, x^6 + y^6 + z^6),
 # with Bernstein 0.41-0.46 and no more bad pixels (the heart 10 of 262,144 against the
-# levels' 15) since each node's ends are F's robust values (see templates/solver.j2); at
+# levels' 15) since each node's ends are F's robust values (see templates/solver/walk.j2); at
 # degree 4 the levels stay faster (Cross-Cap 0.43 against 0.48) and exact (Bernstein
 # misses 15 pixels where the Cross-Cap's sheets meet).
 BERNSTEIN_FROM = 5
@@ -410,7 +410,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
 
 
 def root_levels(n: int, bottom: int) -> range:
-    """The levels k whose roots templates/solver.j2 finds by a function root<k> (the levels
+    """The levels k whose roots templates/solver/levels.j2 finds by a function root<k> (the levels
     strategy): above the closed-form one, up to n (F's pieces), or up to n - 2 where the
     levels n - 1 and n are solved in trace's one Newton loop (lazy: from degree 4)."""
     return range(bottom + 1, n - 1 if n - 1 > bottom else n + 1)
@@ -478,7 +478,7 @@ def bernstein_sums(n: int) -> list[tuple[int, sympy.Expr, sympy.Expr | None]]:
 
 @dataclass(frozen=True)
 class WalkCost:
-    """Operations of the Bernstein walk's parts (arithmetic only, as templates/solver.j2
+    """Operations of the Bernstein walk's parts (arithmetic only, as templates/solver/walk.j2
     prints them), for `implc show`'s per-ray estimate."""
 
     node: int  # Taylor shift, scaling, Bernstein sums, sign changes

@@ -1,4 +1,4 @@
-"""The Bernstein walk's register switches (templates/solver.j2, `exact` from
+"""The Bernstein walk's register switches (templates/solver/walk.j2, `exact` from
 BERNSTEIN_FROM): in double a value takes two registers, and on RDNA3 (gfx1100, about 126
 VGPRs a wave64 holds without spilling) the walk of Chmutov's T19-T20 spilled 5-9 VGPRs to
 scratch until all of these held, and T12-T18 spilled 2-6 SGPRs into a VGPR's lanes

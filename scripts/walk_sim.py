@@ -1,4 +1,4 @@
-"""The exact method's Bernstein walk (templates/solver.j2) re-run in float64 on a view's
+"""The exact method's Bernstein walk (templates/solver/walk.j2) re-run in float64 on a view's
 pixel rays, to weigh its rules for the next node before building them: nodes a ray
 (mean) and the mean over 4x4 pixel blocks of the most any pixel of the block took (what a
 SIMD group pays), for the plain walk (one level a descent, the widest next node after a
