@@ -52,9 +52,9 @@ class WalkRegisters:
     # 1, 2 and 4 it can): each such constant ACO held in 2 SGPRs through the walk (RDNA2/
     # RDNA3, T16-T18: SGPRs spilled). A division is AMD's software reciprocal, 4 constants:
     # the node's middle in half widths, nm/nr = (2 pos - 1 + width)/width (lo = -span/2),
-    # is made exactly from ipos and width's exponent (frexp, ldexp: width is a power of
-    # two), and `reach` is compared as a product; 1/NEXT_FLOOR (0.25) is `floor_halvings`
-    # halvings.
+    # is made exactly from ipos and 1/width, width's exponent bits negated (the language's
+    # power_of_two_inverse: width is a power of two); `reach` is compared as a product;
+    # 1/NEXT_FLOOR (0.25) is `floor_halvings` halvings.
     inline_constants: bool = False
     floor_halvings: int = 0
 
