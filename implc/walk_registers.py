@@ -26,7 +26,9 @@ class WalkRegisters:
     # coefficients were held with the point's powers: T20 134 VGPRs on RDNA2)
     start_first: bool = False
     # the node's start an int ipos in units of pos_unit (2^-POS_BITS printed; pos_units,
-    # its inverse, as a real and as an int), not a double pos and an int index
+    # its inverse, as a real and as an int), not a double pos and an int index; and a
+    # descent's width shifted in those units, not scaled by a select of 2^-L's double
+    # constants (one of which was held in a VGPR through the walk)
     pos_unit: str = ""
     pos_units: str = ""
     pos_units_int: str = ""
@@ -37,15 +39,12 @@ class WalkRegisters:
     # (late_start) the control polygon's pair with the sign change kept through the sums
     # by its index i, an int, and its w_(i-1) chosen after them
     control_index: bool = False
-    # (pos_unit) a descent's width shifted in units of pos_unit, not scaled by a select of
-    # 2^-L's double constants (one of which was held in a VGPR through the walk)
-    descent_by_shift: bool = False
     # how the walk ended, an int `stop` (0 no root, 1 a root, 2 a leaf to test, 3 a touching
     # leaf; a root at a node's start is the one with fl = 0), not the bools found, leaf and
     # touch: set at the loops' breaks, each was a lane mask ACO carried through the walk's
     # loops in SGPRs (RDNA2/RDNA3, T14-T15: SGPRs spilled)
     exit_code: bool = False
-    # (descent_by_shift) a descent's levels an int chosen right after the sums, not from
+    # (pos_unit) a descent's levels an int chosen right after the sums, not from
     # the cross_i at the descent: those were held as lane masks from the sums to it
     descent_int: bool = False
     # (pos_unit) no double constant in the walk's loop that AMD cannot encode inline (0.5,
@@ -72,6 +71,6 @@ def walk_registers(precision: str, float_literal, next_floor: int) -> WalkRegist
                          pos_units=float_literal(2.0 ** POS_BITS),
                          pos_units_int=str(2 ** POS_BITS),
                          width_floor=float_literal(2.0 ** -WIDTH_BITS),
-                         end_signs=True, control_index=True, descent_by_shift=True,
-                         exit_code=True, descent_int=True, inline_constants=True,
+                         end_signs=True, control_index=True, exit_code=True,
+                         descent_int=True, inline_constants=True,
                          floor_halvings=next_floor.bit_length() - 1)
