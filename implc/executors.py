@@ -44,8 +44,12 @@ def worker_signals() -> None:
 
 def stop_executor(executor: Executor) -> None:
     """Cancel what has not started and, for local processes, end the workers now (an
-    interrupted run)."""
+    interrupted run), then wait for the pool's manager thread: left running, it closed
+    its wake-up pipe while concurrent.futures' exit hook wrote to it, and the run ended
+    on a traceback after "implc: terminated" (test_fault[corpus-SIGTERM], once in a
+    clean-clone run)."""
     processes = list((getattr(executor, "_processes", None) or {}).values())  # no public handle
+    manager = getattr(executor, "_executor_manager_thread", None)
     executor.shutdown(wait=False, cancel_futures=True)
     for process in processes:
         with contextlib.suppress(Exception):
@@ -53,6 +57,8 @@ def stop_executor(executor: Executor) -> None:
     for process in processes:
         with contextlib.suppress(Exception):
             process.join(5)
+    if manager is not None:
+        manager.join(5)
 
 
 def effective_jobs(jobs: int | None) -> int:
