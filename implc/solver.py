@@ -214,7 +214,7 @@ class Solver:
     # bernstein: Newton's start computed after the walk from the root node's coefficients
     # again, not kept through it (double: RDNA3 spilled the walk from degree 13)
     late_start: bool = False
-    # bernstein: the walk's values held in fewer registers (double; implc/walk_registers.py)
+    # bernstein: the walk's values in fewer registers (which, by precision: walk_registers.py)
     registers: WalkRegisters = WalkRegisters()
 
 

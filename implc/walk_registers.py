@@ -5,7 +5,10 @@ scratch until all of these held, and T12-T18 spilled 2-6 SGPRs into a VGPR's lan
 (tests/test_gpu_stats.py). Each keeps the program's values bit for bit but
 inline_constants, whose node middle is exact where nm/nr rounded and whose `reach` is
 compared as a product: exact's pictures in double (gl-double, cl-double) stayed
-bit-identical in hit, t and steps. Float's programs take none of them."""
+bit-identical in hit, t and steps. Float's programs take exit_code alone (4-5 % fewer
+instructions on RDNA2/RDNA3 at T6-T20, the same pictures): the others need a double's
+range (pos_unit's 2^-30 is beyond a float's 24 bits), F's values (float re-expands F
+where its ends disagree with the coefficients) or late_start (control_index)."""
 
 from __future__ import annotations
 
@@ -59,13 +62,13 @@ class WalkRegisters:
 
 
 def walk_registers(precision: str, float_literal, next_floor: int) -> WalkRegisters:
-    """All the switches in double, none in float (double's F is expanded once, about the
-    chord's middle: it never re-expands, so S at the chord's start can come first);
-    `next_floor`: solver.NEXT_FLOOR, a power of two."""
+    """All the switches in double, exit_code alone in float (double's F is expanded once,
+    about the chord's middle: it never re-expands, so S at the chord's start can come
+    first); `next_floor`: solver.NEXT_FLOOR, a power of two."""
     if next_floor & (next_floor - 1):
         raise ValueError(f"NEXT_FLOOR {next_floor} is not a power of two")
     if precision != "double":
-        return WalkRegisters()
+        return WalkRegisters(exit_code=True)
     return WalkRegisters(start_first=True,
                          pos_unit=float_literal(2.0 ** -POS_BITS),
                          pos_units=float_literal(2.0 ** POS_BITS),

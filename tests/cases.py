@@ -51,7 +51,9 @@ def golden_cases(target: str) -> list[GoldenCase]:
     method on the paper surfaces; a library emit of each paper surface with hessian and
     taylor; the Cross-Cap's exact solver in every other flavour, as a library and in
     every other precision (and hessian there too); the `--taylor2 consistent` branch of
-    both Hessian methods; the gyroid with interval (program and library)."""
+    both Hessian methods; the gyroid with interval (program and library); Barth's decic
+    with exact in every precision (the Bernstein walk, from degree 5, in float and in
+    double's fewer registers: implc/walk_registers.py)."""
     t = TARGETS[target]
     other_flavors = [f for f in t.flavors if f != t.default_flavor]
     other_precisions = [p for p in t.precisions if p != "float"]
@@ -69,6 +71,7 @@ def golden_cases(target: str) -> list[GoldenCase]:
     cases += [case("cross-cap", m, taylor2="consistent") for m in ("hessian", "hessian-approx")]
     cases += [case("cross-cap", "exact", emit="library")]
     cases += [case("gyroid", "interval", emit=kind) for kind in ("program", "library")]
+    cases += [case("barth-decic", "exact", precision=p) for p in t.precisions]
     return cases
 
 
