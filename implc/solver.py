@@ -193,9 +193,9 @@ class Solver:
     control_step: str = ""
     # bernstein: the Newton after the walk takes F's robust value (ROBUST_NEWTON_BELOW)
     robust_newton: bool = False
-    # bernstein: a descent's levels (see DESCENT_LEVELS), shallowest first: (L, 2^-L
-    # printed, the pairs (b_(i-1), b_i) by i whose sign change sends it L levels down)
-    descent: tuple[tuple[int, str, tuple[int, ...]], ...] = ()
+    # bernstein: a descent's levels (see DESCENT_LEVELS), shallowest first: (L, the pairs
+    # (b_(i-1), b_i) by i whose sign change sends it L levels down)
+    descent: tuple[tuple[int, tuple[int, ...]], ...] = ()
     # bernstein: NEXT_REACH/n printed (the next node's reach is it times |b_n/(b_n -
     # b_(n-1))| times the skipped node's width), 1/NEXT_FLOOR printed, NEXT_HALVINGS
     next_reach: str = ""
@@ -384,8 +384,7 @@ def lower_solver(constants: Constants, expr: sympy.Expr, printer, prefix: str,
         recenter = re_expands(expr, printer.precision)
         solver = Solver(n, bottom, closed, "bernstein", bernstein_lets(n, printer),
                         control_w, printer.float_literal(2 / n), robust_newton,
-                        tuple((level, printer.float_literal(0.5 ** level), pairs)
-                              for level, pairs in descent_levels(n)),
+                        descent_levels(n),
                         printer.float_literal(NEXT_REACH / n),
                         printer.float_literal(1 / NEXT_FLOOR), NEXT_HALVINGS,
                         printer.float_literal(FIRST_REACH), FIRST_HALVINGS,

@@ -263,8 +263,8 @@ Ray ray_of(dvec3 ro, dvec3 rd, double sm, double hr) {
 // control polygon's first sign change. Nodes are visited left to right and the first
 // root ends the walk, so a ray pays for no root beyond it; its root is found by one
 // bracketed Newton after the walk, from the zero of that node's control polygon. The
-// next node follows from pos, width and the node's index (no stack), narrowed where F
-// heads towards zero.
+// next node follows from the node's start and width (no stack), narrowed where F heads
+// towards zero.
 // Every branch of the walk's loop is paid at every node by a SIMD group with one lane in
 // it (and by llvmpipe whether or not one is), so the loop holds only what every node
 // needs; what few nodes need (the touch test at a leaf) runs after it.
@@ -280,8 +280,9 @@ Hit trace(dvec3 ro, dvec3 rd, double t0, double t1) {
     double start_f = S(chord_start);
     double d0 = dot(grad(chord_start), rd)*span;
     Ray ray = ray_of(ro, rd, sm, 0.5lf*(t1 - t0));
-    // how the walk ended (solver.registers.exit_code): 0 no root, 1 a root (at a node's
-    // start where fl = 0), 2 a leaf to test, 3 a leaf where F touches zero
+    // how the walk ended: 0 no root, 1 a root (at a node's start where fl = 0), 2 a leaf
+    // to test, 3 a leaf where F touches zero (an int, not the booleans found, leaf and
+    // touch: each was a lane mask AMD's compiler carried through the walk's loops in SGPRs)
     int stop = 0;
     // the node's start in units of pos_unit (an int: one register where a double takes two;
     // pos and width are dyadic, so exact)
@@ -305,7 +306,7 @@ Hit trace(dvec3 ro, dvec3 rd, double t0, double t1) {
     width = (toward0 && width > reach0 ? 0.5lf*width : width);
     width = (toward0 && width > reach0 ? 0.5lf*width : width);
     width = (toward0 && width > reach0 ? 0.5lf*width : width);
-    // A leaf that may still hold roots stops the walk (`leaf`); F's touch test at its
+    // A leaf that may still hold roots stops the walk (stop 2); F's touch test at its
     // middle runs after the walk, which goes on after the leaf when F does not touch zero
     // there (measured in the loop: 20 % of the frame on Chmutov's T18, 11 % on x^18 sums,
     // where no leaf is reached).
@@ -460,7 +461,8 @@ Hit trace(dvec3 ro, dvec3 rd, double t0, double t1) {
             double b10 = be0 + bo0;
             bool cross10 = b9*b10 <= 0.0lf;
             changes += (cross10 ? 1 : 0);
-            // a descent's levels, chosen here (solver.registers.descent_int)
+            // a descent's levels, chosen here: from the cross_i at the descent, they were
+            // held as lane masks from the sums to it
             int down = (cross1 ? 3 : (cross1 || cross2 ? 2 : 1));
             // F's ends decide where they and the coefficients agree: one sign change of
             // both is exactly one root, none of both is none; where they disagree (the

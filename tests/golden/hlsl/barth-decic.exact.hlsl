@@ -289,8 +289,8 @@ Ray ray_of(float3 ro, float3 rd, float sm, float hr) {
 // control polygon's first sign change. Nodes are visited left to right and the first
 // root ends the walk, so a ray pays for no root beyond it; its root is found by one
 // bracketed Newton after the walk, from the zero of that node's control polygon. The
-// next node follows from pos, width and the node's index (no stack), narrowed where F
-// heads towards zero.
+// next node follows from the node's start and width (no stack), narrowed where F heads
+// towards zero.
 // Every branch of the walk's loop is paid at every node by a SIMD group with one lane in
 // it (and by llvmpipe whether or not one is), so the loop holds only what every node
 // needs; what few nodes need (the touch test at a leaf) runs after it.
@@ -299,16 +299,18 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     Ray ray = ray_of(ro, rd, 0.5*(t0 + t1), 0.5*(t1 - t0));
     float lo = t0 - ray.sm;
     float span = t1 - t0;
-    // how the walk ended (solver.registers.exit_code): 0 no root, 1 a root (at a node's
-    // start where fl = 0), 2 a leaf to test, 3 a leaf where F touches zero
+    // how the walk ended: 0 no root, 1 a root (at a node's start where fl = 0), 2 a leaf
+    // to test, 3 a leaf where F touches zero (an int, not the booleans found, leaf and
+    // touch: each was a lane mask AMD's compiler carried through the walk's loops in SGPRs)
     int stop = 0;
     float u = t1 - ray.sm;
-    float pos = 0.0;
+    // the node's start in units of pos_unit (an int: one register where a double takes two;
+    // pos and width are dyadic, so exact)
+    int ipos = 0;
     // the first node is the chord's left half, not the chord: a ray that meets the surface
     // has two roots or more on its chord (in and out), so the chord would be halved anyway
     // (docs/RESULTS.md section 8: 8-16 % a frame)
     float width = 0.5;
-    int index = 0;
     int nodes = 0;
     float x0 = lo;
     // F's robust value at the node's left end (P10: S at the point where Estrin's sign is
@@ -326,7 +328,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     width = (toward0 && width > reach0 ? 0.5*width : width);
     width = (toward0 && width > reach0 ? 0.5*width : width);
     width = (toward0 && width > reach0 ? 0.5*width : width);
-    // A leaf that may still hold roots stops the walk (`leaf`); F's touch test at its
+    // A leaf that may still hold roots stops the walk (stop 2); F's touch test at its
     // middle runs after the walk, which goes on after the leaf when F does not touch zero
     // there (measured in the loop: 20 % of the frame on Chmutov's T18, 11 % on x^18 sums,
     // where no leaf is reached).
@@ -336,7 +338,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
                 break;
             }
             nodes += 1;
-            float na = lo + pos*span;
+            float na = lo + (float(ipos)*5.960464477539063e-08)*span;
             float nh = width*span;
             float nm = na + 0.5*nh;
             float nr = 0.5*nh;
@@ -511,6 +513,9 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
             cw = (cross6 ? 0.0 : cw);
             cb0 = (cross6 ? b5 : cb0);
             cb1 = (cross6 ? b6 : cb1);
+            // a descent's levels, chosen here: from the cross_i at the descent, they were
+            // held as lane masks from the sums to it
+            int down = (cross1 ? 3 : (cross1 || cross2 ? 2 : 1));
             // F's ends decide where they and the coefficients agree: one sign change of
             // both is exactly one root, none of both is none; where they disagree (the
             // coefficients' rounding) or the coefficients change sign more than once, the
@@ -532,10 +537,10 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
                 }
                 // down to the deepest node at the left end that holds the control
                 // polygon's first sign change, up to 3 levels at once
-                bool down2 = cross1 || cross2;
-                bool down3 = cross1;
-                width = (down3 ? 0.125 : (down2 ? 0.25 : 0.5))*width;
-                index = (down3 ? 8 : (down2 ? 4 : 2))*index;
+                // 2^-L as a shift of the width in units of pos_unit (exact): a select of
+                // 2^-L's double constants held one of them in a VGPR through the walk, and
+                // ldexp cost llvmpipe 1-2 % a frame (T20)
+                width = float(int(width*16777216.0) >> down)*5.960464477539063e-08;
             } else {
                 // the next node: the widest its position allows, narrowed where F heads
                 // towards zero at this node's end to within NEXT_REACH times the distance
@@ -543,21 +548,20 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
                 // of this node): a wide node there would hold that zero and be halved again
                 bool toward = b10*(b10 - b9) < 0.0;
                 float reach = 0.4*abs(b10/(b10 - b9))*width;
-                float least = 0.25*width;
+                // (and not below width_floor: ipos counts in 2^-POS_BITS)
+                float least = max(0.25*width, 9.5367431640625e-07);
                 fl = fr;
-                pos = pos + width;
-                if (pos >= 1.0) {
+                // ipos + width/pos_unit: the next node's start in units of pos_unit, and its widest
+                // width ipos's lowest set bit
+                ipos += int(width*16777216.0);
+                if (ipos >= 16777216) {
                     break;
                 }
-                index += 1;
-                int low = index & -index;
-                index = index/low;
-                width = width*float(low);
+                width = float(ipos & -ipos)*5.960464477539063e-08;
                 width = (toward && width > reach && width > least ? 0.5*width : width);
                 width = (toward && width > reach && width > least ? 0.5*width : width);
                 width = (toward && width > reach && width > least ? 0.5*width : width);
                 width = (toward && width > reach && width > least ? 0.5*width : width);
-                index = (toward ? int(pos/width) : index);
             }
         }
         if (stop != 2) {
@@ -571,14 +575,13 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
             break;
         }
         fl = fr;
-        pos = pos + width;
-        if (pos >= 1.0) {
+        // ipos + width/pos_unit: the next node's start in units of pos_unit, and its widest
+        // width ipos's lowest set bit
+        ipos += int(width*16777216.0);
+        if (ipos >= 16777216) {
             break;
         }
-        index += 1;
-        int low = index & -index;
-        index = index/low;
-        width = width*float(low);
+        width = float(ipos & -ipos)*5.960464477539063e-08;
     }
     // The walk ended at a node with exactly one root, [a, b]: a bracketed Newton finds it,
     // once for the SIMD group whichever node each lane stopped at. Its F is P10, robust
@@ -592,7 +595,7 @@ Hit trace(float3 ro, float3 rd, float t0, float t1) {
     // a root node's (stop 1; not a touching root: at a node's start, where fl = 0, or a
     // leaf, stop 3)
     if (stop == 1 && fl != 0.0) {
-        float a = lo + pos*span;
+        float a = lo + (float(ipos)*5.960464477539063e-08)*span;
         float b = a + width*span;
         float fa = fl;
         float x = x0;

@@ -267,8 +267,8 @@ fn ray_of(ro: vec3<f32>, rd: vec3<f32>, sm: f32, hr: f32) -> Ray {
 // control polygon's first sign change. Nodes are visited left to right and the first
 // root ends the walk, so a ray pays for no root beyond it; its root is found by one
 // bracketed Newton after the walk, from the zero of that node's control polygon. The
-// next node follows from pos, width and the node's index (no stack), narrowed where F
-// heads towards zero.
+// next node follows from the node's start and width (no stack), narrowed where F heads
+// towards zero.
 // Every branch of the walk's loop is paid at every node by a SIMD group with one lane in
 // it (and by llvmpipe whether or not one is), so the loop holds only what every node
 // needs; what few nodes need (the touch test at a leaf) runs after it.
@@ -277,16 +277,18 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     let ray: Ray = ray_of(ro, rd, 0.5f*(t0 + t1), 0.5f*(t1 - t0));
     let lo: f32 = t0 - ray.sm;
     let span: f32 = t1 - t0;
-    // how the walk ended (solver.registers.exit_code): 0 no root, 1 a root (at a node's
-    // start where fl = 0), 2 a leaf to test, 3 a leaf where F touches zero
+    // how the walk ended: 0 no root, 1 a root (at a node's start where fl = 0), 2 a leaf
+    // to test, 3 a leaf where F touches zero (an int, not the booleans found, leaf and
+    // touch: each was a lane mask AMD's compiler carried through the walk's loops in SGPRs)
     var stop: i32 = 0;
     var u: f32 = t1 - ray.sm;
-    var pos: f32 = 0.0f;
+    // the node's start in units of pos_unit (an int: one register where a double takes two;
+    // pos and width are dyadic, so exact)
+    var ipos: i32 = 0;
     // the first node is the chord's left half, not the chord: a ray that meets the surface
     // has two roots or more on its chord (in and out), so the chord would be halved anyway
     // (docs/RESULTS.md section 8: 8-16 % a frame)
     var width: f32 = 0.5f;
-    var index: i32 = 0;
     var nodes: i32 = 0;
     var x0: f32 = lo;
     // F's robust value at the node's left end (P10: S at the point where Estrin's sign is
@@ -304,7 +306,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     width = select(width, 0.5f*width, toward0 && width > reach0);
     width = select(width, 0.5f*width, toward0 && width > reach0);
     width = select(width, 0.5f*width, toward0 && width > reach0);
-    // A leaf that may still hold roots stops the walk (`leaf`); F's touch test at its
+    // A leaf that may still hold roots stops the walk (stop 2); F's touch test at its
     // middle runs after the walk, which goes on after the leaf when F does not touch zero
     // there (measured in the loop: 20 % of the frame on Chmutov's T18, 11 % on x^18 sums,
     // where no leaf is reached).
@@ -314,7 +316,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 break;
             }
             nodes += 1;
-            let na: f32 = lo + pos*span;
+            let na: f32 = lo + (f32(ipos)*5.960464477539063e-08f)*span;
             let nh: f32 = width*span;
             let nm: f32 = na + 0.5f*nh;
             let nr: f32 = 0.5f*nh;
@@ -489,6 +491,9 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             cw = select(cw, 0.0f, cross6);
             cb0 = select(cb0, b5, cross6);
             cb1 = select(cb1, b6, cross6);
+            // a descent's levels, chosen here: from the cross_i at the descent, they were
+            // held as lane masks from the sums to it
+            let down: i32 = select(select(1, 2, cross1 || cross2), 3, cross1);
             // F's ends decide where they and the coefficients agree: one sign change of
             // both is exactly one root, none of both is none; where they disagree (the
             // coefficients' rounding) or the coefficients change sign more than once, the
@@ -510,10 +515,10 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 }
                 // down to the deepest node at the left end that holds the control
                 // polygon's first sign change, up to 3 levels at once
-                let down2: bool = cross1 || cross2;
-                let down3: bool = cross1;
-                width = select(select(0.5f, 0.25f, down2), 0.125f, down3)*width;
-                index = select(select(2, 4, down2), 8, down3)*index;
+                // 2^-L as a shift of the width in units of pos_unit (exact): a select of
+                // 2^-L's double constants held one of them in a VGPR through the walk, and
+                // ldexp cost llvmpipe 1-2 % a frame (T20)
+                width = f32(i32(width*16777216.0f) >> u32(down))*5.960464477539063e-08f;
             } else {
                 // the next node: the widest its position allows, narrowed where F heads
                 // towards zero at this node's end to within NEXT_REACH times the distance
@@ -521,21 +526,20 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
                 // of this node): a wide node there would hold that zero and be halved again
                 let toward: bool = b10*(b10 - b9) < 0.0f;
                 let reach: f32 = 0.4f*abs(b10/(b10 - b9))*width;
-                let least: f32 = 0.25f*width;
+                // (and not below width_floor: ipos counts in 2^-POS_BITS)
+                let least: f32 = max(0.25f*width, 9.5367431640625e-07f);
                 fl = fr;
-                pos = pos + width;
-                if (pos >= 1.0f) {
+                // ipos + width/pos_unit: the next node's start in units of pos_unit, and its widest
+                // width ipos's lowest set bit
+                ipos += i32(width*16777216.0f);
+                if (ipos >= 16777216) {
                     break;
                 }
-                index += 1;
-                let low: i32 = index & -index;
-                index = index/low;
-                width = width*f32(low);
+                width = f32(ipos & -ipos)*5.960464477539063e-08f;
                 width = select(width, 0.5f*width, toward && width > reach && width > least);
                 width = select(width, 0.5f*width, toward && width > reach && width > least);
                 width = select(width, 0.5f*width, toward && width > reach && width > least);
                 width = select(width, 0.5f*width, toward && width > reach && width > least);
-                index = select(index, i32(pos/width), toward);
             }
         }
         if (stop != 2) {
@@ -549,14 +553,13 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
             break;
         }
         fl = fr;
-        pos = pos + width;
-        if (pos >= 1.0f) {
+        // ipos + width/pos_unit: the next node's start in units of pos_unit, and its widest
+        // width ipos's lowest set bit
+        ipos += i32(width*16777216.0f);
+        if (ipos >= 16777216) {
             break;
         }
-        index += 1;
-        let low: i32 = index & -index;
-        index = index/low;
-        width = width*f32(low);
+        width = f32(ipos & -ipos)*5.960464477539063e-08f;
     }
     // The walk ended at a node with exactly one root, [a, b]: a bracketed Newton finds it,
     // once for the SIMD group whichever node each lane stopped at. Its F is P10, robust
@@ -570,7 +573,7 @@ fn trace(ro: vec3<f32>, rd: vec3<f32>, t0: f32, t1: f32) -> Hit {
     // a root node's (stop 1; not a touching root: at a node's start, where fl = 0, or a
     // leaf, stop 3)
     if (stop == 1 && fl != 0.0f) {
-        var a: f32 = lo + pos*span;
+        var a: f32 = lo + (f32(ipos)*5.960464477539063e-08f)*span;
         var b: f32 = a + width*span;
         var fa: f32 = fl;
         var x: f32 = x0;
