@@ -33,8 +33,8 @@ class WalkRegisters:
     units (a select of 2^-L's double constants held one of them in a VGPR through the
     walk); the walk's end is an int `stop` (0 no root, 1 a root, 2 a leaf to test, 3 a
     touching leaf), not the bools found, leaf and touch, each a lane mask ACO carried
-    through the walk's loops in SGPRs (RDNA2/RDNA3, double T14-T15: SGPRs spilled; float:
-    4-5 % of the instructions at T6-T20)."""
+    through the walk's loops in SGPRs (RDNA2/RDNA3, double T14-T15: SGPRs spilled; float,
+    with the int start: 6-11 % of exact's instructions at T6-T20)."""
 
     pos_unit: str = ""
     pos_units: str = ""
