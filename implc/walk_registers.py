@@ -14,7 +14,7 @@ each re-expansion (start_first)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 # the walk's node start, an int in units of 2^-POS_BITS: a width is at least 2^-WIDTH_BITS
 # there (a descent stops at 2^-(BERNSTEIN_DEPTH + 3); only the next node's narrowing went
@@ -72,7 +72,5 @@ def walk_registers(precision: str, float_literal, next_floor: int) -> WalkRegist
                           width_floor=float_literal(2.0 ** -width_bits))
     if precision != "double":
         return where
-    return WalkRegisters(where.pos_unit, where.pos_units, where.pos_units_int,
-                         where.width_floor, start_first=True, end_signs=True,
-                         control_index=True, inline_constants=True,
-                         floor_halvings=next_floor.bit_length() - 1)
+    return replace(where, start_first=True, end_signs=True, control_index=True,
+                   inline_constants=True, floor_halvings=next_floor.bit_length() - 1)

@@ -48,7 +48,7 @@ PROGRAMS = (("hlsl", None, "float"), ("glsl", "450", "float"))
 # through its loops, and spills the exec masks of the ifs around them into a VGPR's
 # lanes) until the sums' odd part was summed negated (T12-T13: no constant of its own for
 # e_1's negative weight), the walk's end became an int and a descent's levels an int
-# chosen after the sums (walk_registers.WalkRegisters.exit_code, descent_int; T14-T15),
+# chosen after the sums (walk_registers, in both precisions now; T14-T15),
 # and the walk's loop held no double constant AMD cannot encode inline (inline_constants:
 # no division, a division being AMD's software reciprocal with 4 constants; T16-T18);
 # it still spills 6 at 19-20 (EXACT_DOUBLE_VGPRS_UP_TO guards its VGPRs beyond).
